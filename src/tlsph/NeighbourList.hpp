@@ -1,0 +1,28 @@
+// Reference-configuration neighbour search: a cell list, built once, stored as full
+// (both-direction) compressed-sparse-row lists so each particle gathers its own sums.
+#pragma once
+
+#include <vector>
+
+#include "tlsph/PeriodicBox.hpp"
+#include "tlsph/Types.hpp"
+
+namespace tlsph {
+
+struct NeighbourList {
+  std::vector<Index> offset;     // neighbours of I are neighbour[offset[I] .. offset[I+1])
+  std::vector<Index> neighbour;  // sorted ascending within each particle
+
+  Index particleCount() const { return static_cast<Index>(offset.size()) - 1; }
+  Index pairCount() const { return static_cast<Index>(neighbour.size()); }
+  Index count(Index i) const { return offset[i + 1] - offset[i]; }
+};
+
+// All J != I with |X_IJ| < supportRadius (minimum image along periodic axes).
+// Throws SetupError if a periodic box is shorter than twice the support radius,
+// where one pair would have more than one image inside the support.
+template <int D>
+NeighbourList buildNeighbourList(const std::vector<Vec<D>>& X, double supportRadius,
+                                 const PeriodicBox<D>& box = {});
+
+}  // namespace tlsph

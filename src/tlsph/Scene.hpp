@@ -1,0 +1,25 @@
+// What is simulated: particles, their materials and the discretisation choices.
+#pragma once
+
+#include <vector>
+
+#include "materials/Material.hpp"
+#include "tlsph/Kernel.hpp"
+#include "tlsph/Particles.hpp"
+#include "tlsph/PeriodicBox.hpp"
+#include "tlsph/Types.hpp"
+
+namespace tlsph {
+
+template <int D>
+struct Scene {
+  ParticleSet<D> particles;
+  std::vector<Material> materials;
+  KernelType kernel = KernelType::WendlandC2;
+  double supportRadius = 0.0;         // H = 2h
+  double hourglassCoefficient = 0.0;  // alpha of (6.80); 0: no hourglass pass at all
+  PeriodicBox<D> periodicBox;
+  Vec<D> gravity = Vec<D>::Zero();  // body force per unit mass
+};
+
+}  // namespace tlsph

@@ -1,0 +1,124 @@
+// Small particle clouds and a force evaluator shared by the core tests.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "materials/Material.hpp"
+#include "tlsph/Lattice.hpp"
+#include "tlsph/ReferenceConfiguration.hpp"
+#include "tlsph/Scene.hpp"
+#include "tlsph/TlsphForces.hpp"
+
+namespace tlsph::testing {
+
+// A block of counts[a] cells of size dx with every particle moved by up to
+// jitter * dx per axis; volumes stay dx^D.
+template <int D>
+std::vector<Vec<D>> perturbedBlock(const std::array<int, D>& counts, double dx, double jitter,
+                                   std::mt19937& rng) {
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  auto points = cellCentredLattice<D>(Vec<D>::Zero(), counts, dx);
+  for (auto& x : points)
+    for (int a = 0; a < D; ++a)
+      x[a] += jitter * dx * unit(rng);
+  return points;
+}
+
+template <int D>
+Scene<D> sceneOf(const std::vector<Vec<D>>& X, double dx, double supportRatio, Material material,
+                 double alpha = 0.0) {
+  Scene<D> scene;
+  scene.materials.push_back(std::move(material));
+  scene.supportRadius = supportRatio * dx;
+  scene.hourglassCoefficient = alpha;
+  const double V = std::pow(dx, D);
+  for (const auto& x : X)
+    scene.particles.add(x, V, density(scene.materials[0]) * V, 0);
+  return scene;
+}
+
+// Internal (+ hourglass) forces and strain energy as functions of the displacement field.
+template <int D>
+class ForceEvaluator {
+ public:
+  explicit ForceEvaluator(Scene<D> scene)
+      : scene_(std::move(scene)),
+        ref_(buildReferenceConfiguration<D>(
+            scene_.particles.referencePosition, scene_.particles.volume,
+            Kernel<D>(scene_.kernel, scene_.supportRadius), scene_.periodicBox)),
+        forces_(ref_, scene_.materials, scene_.particles.material, scene_.particles.volume,
+                scene_.hourglassCoefficient) {}
+  ForceEvaluator(const ForceEvaluator&) = delete;
+  ForceEvaluator& operator=(const ForceEvaluator&) = delete;
+
+  Index size() const { return scene_.particles.size(); }
+  const Scene<D>& scene() const { return scene_; }
+  const ReferenceConfiguration<D>& reference() const { return ref_; }
+  TlsphForces<D>& forces() { return forces_; }
+
+  std::vector<Vec<D>> force(const std::vector<Vec<D>>& u) {
+    std::vector<Vec<D>> f(size());
+    forces_.compute(u, f);
+    return f;
+  }
+  double energy(const std::vector<Vec<D>>& u) {
+    force(u);
+    return forces_.strainEnergy();
+  }
+  std::vector<Vec<D>> currentPositions(const std::vector<Vec<D>>& u) const {
+    std::vector<Vec<D>> x(size());
+    for (Index i = 0; i < size(); ++i)
+      x[i] = scene_.particles.referencePosition[i] + u[i];
+    return x;
+  }
+
+ private:
+  Scene<D> scene_;
+  ReferenceConfiguration<D> ref_;
+  TlsphForces<D> forces_;
+};
+
+template <int D>
+Mat<D> randomMatrix(std::mt19937& rng, double scale) {
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  Mat<D> A;
+  for (int r = 0; r < D; ++r)
+    for (int c = 0; c < D; ++c)
+      A(r, c) = scale * unit(rng);
+  return A;
+}
+
+template <int D>
+Vec<D> randomVector(std::mt19937& rng, double scale) {
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  Vec<D> v;
+  for (int a = 0; a < D; ++a)
+    v[a] = scale * unit(rng);
+  return v;
+}
+
+// A proper rotation from random axis/angle (3D) or angle (2D).
+template <int D>
+Mat<D> randomRotation(std::mt19937& rng) {
+  std::uniform_real_distribution<double> angle(-3.0, 3.0);
+  if constexpr (D == 2) {
+    const double t = angle(rng);
+    Mat<2> R;
+    R << std::cos(t), -std::sin(t), std::sin(t), std::cos(t);
+    return R;
+  } else {
+    const Vec3 axis = randomVector<3>(rng, 1.0).normalized();
+    return Eigen::AngleAxisd(angle(rng), axis).toRotationMatrix();
+  }
+}
+
+inline Material testMaterial(const std::string& name) {
+  return makeMaterial(name, ElasticConstants::fromYoungPoisson(2.0e6, 0.3), 1000.0);
+}
+
+}  // namespace tlsph::testing
