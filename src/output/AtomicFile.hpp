@@ -1,0 +1,15 @@
+// Files appear whole or not at all: written under a temporary name, then renamed.
+#pragma once
+
+#include <filesystem>
+#include <functional>
+
+namespace tlsph {
+
+// Calls write(temporary) to produce the file, then renames it onto `target` (atomic on
+// POSIX within one file system). If write throws, the temporary is removed and the
+// target is left as it was. Creates the parent directory if needed.
+void writeAtomically(const std::filesystem::path& target,
+                     const std::function<void(const std::filesystem::path&)>& write);
+
+}  // namespace tlsph
