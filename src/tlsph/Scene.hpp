@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "materials/Material.hpp"
+#include "tlsph/Conditions.hpp"
 #include "tlsph/Kernel.hpp"
 #include "tlsph/Particles.hpp"
 #include "tlsph/PeriodicBox.hpp"
@@ -20,6 +21,10 @@ struct Scene {
   double hourglassCoefficient = 0.0;  // alpha of (6.80); 0: no hourglass pass at all
   PeriodicBox<D> periodicBox;
   Vec<D> gravity = Vec<D>::Zero();  // body force per unit mass
+  Ramp gravityRamp;
+  std::vector<Prescription<D>> prescriptions;  // their particles must have Motion::Prescribed
+  std::vector<Load<D>> loads;
+  Damping damping;
 };
 
 }  // namespace tlsph

@@ -1,7 +1,9 @@
-// Advances a Scene in time with velocity Verlet (kick-drift-kick), keeping the energy books.
+// Advances a Scene in time with velocity Verlet (kick-drift-kick), applying its boundary
+// conditions, loads and damping, and keeping the energy books.
 #pragma once
 
-#include <stdexcept>
+#include <cmath>
+#include <string>
 #include <vector>
 
 #include "tlsph/Diagnostics.hpp"
@@ -18,15 +20,19 @@ struct SolverSettings {
   double timeStep = 0.0;  // > 0 overrides the wave-speed rule
 };
 
-// Energy books of a run. Without damping `total()` is conserved up to the time
-// discretisation error: kinetic + strain + hourglass - work put in by loads and boundaries.
+// Energy books of a run: `total()` is conserved up to the O(dt^2) time discretisation
+// error: kinetic + strain + hourglass - work put in by loads and boundaries + energy
+// taken out by damping.
 struct EnergyBalance {
   double kinetic = 0.0;
   double strain = 0.0;        // sum_I V_I psi(F_I), all particles (ghost F depends on the body)
   double hourglass = 0.0;     // work done against the hourglass force
-  double externalWork = 0.0;  // work of body forces on free particles
+  double externalWork = 0.0;  // work of body forces and loads on free particles
   double boundaryWork = 0.0;  // work of prescribed particles on the rest
-  double total() const { return kinetic + strain + hourglass - externalWork - boundaryWork; }
+  double damped = 0.0;        // energy removed by viscous and kinetic damping
+  double total() const {
+    return kinetic + strain + hourglass - externalWork - boundaryWork + damped;
+  }
 };
 
 template <int D>
@@ -41,11 +47,37 @@ class Solver {
         forces_(ref_, scene.materials, scene.particles.material, scene.particles.volume,
                 scene.hourglassCoefficient) {
     if (!(settings.cfl > 0.0)) throw SetupError("the CFL number must be positive");
+    const auto& p = scene.particles;
     dt_ = settings.timeStep > 0.0 ? settings.timeStep
-                                  : stableTimeStep(scene.particles, scene.materials, settings.cfl);
-    for (Index i = 0; i < scene.particles.size(); ++i)
-      (scene.particles.motion[i] == Motion::Free ? free_ : prescribed_).push_back(i);
+                                  : stableTimeStep(p, scene.materials, settings.cfl);
+    std::vector<int> slot(p.size(), -1);
+    for (Index i = 0; i < p.size(); ++i) {
+      if (p.motion[i] == Motion::Free) {
+        free_.push_back(i);
+      } else {
+        slot[i] = static_cast<int>(prescribed_.size());
+        prescribed_.push_back(i);
+      }
+    }
+    rule_.assign(prescribed_.size(), -1);
+    start_.resize(prescribed_.size());
+    step_.assign(prescribed_.size(), Vec<D>::Zero());
+    for (std::size_t r = 0; r < scene.prescriptions.size(); ++r)
+      for (Index i : scene.prescriptions[r].particles) {
+        if (i < 0 || i >= p.size() || slot[i] < 0)
+          throw SetupError("prescription '" + scene.prescriptions[r].name + "' names particle " +
+                           std::to_string(i) + ", which is not a prescribed particle");
+        rule_[slot[i]] = static_cast<int>(r);
+      }
+    for (std::size_t k = 0; k < prescribed_.size(); ++k)
+      start_[k] = p.displacement[prescribed_[k]];
+    hasExternal_ = !scene.gravity.isZero() || !scene.loads.empty();
+    if (hasExternal_) {
+      external_.assign(p.size(), Vec<D>::Zero());
+      computeExternalForces(0.0);
+    }
     forces_.compute(scene.particles.displacement, scene.particles.force);
+    previousKinetic_ = kineticEnergy(scene.particles);
   }
 
   double time() const { return time_; }
@@ -53,51 +85,76 @@ class Solver {
   long stepCount() const { return steps_; }
   const ReferenceConfiguration<D>& reference() const { return ref_; }
   const TlsphForces<D>& forces() const { return forces_; }
+  // External force (body forces and loads) on each particle at the current time; empty
+  // when the scene has none.
+  const std::vector<Vec<D>>& externalForce() const { return external_; }
 
   void step() {
     auto& p = scene_.particles;
-    const Vec<D> g = scene_.gravity;
     const double halfDt = 0.5 * dt_;
+    const double c = scene_.damping.viscous;
     const Index nFree = static_cast<Index>(free_.size());
-    // Kick, then drift; the work terms use the trapezoidal rule over the drift
-    // (half with the old forces here, half with the new ones below).
-    double hourglassWork = 0.0, externalWork = 0.0, boundaryWork = 0.0;
-#pragma omp parallel for reduction(+ : hourglassWork, externalWork) schedule(static)
+    const Index nPrescribed = static_cast<Index>(prescribed_.size());
+    const bool hourglass = forces_.hourglassEnabled();
+    double hourglassWork = 0.0, externalWork = 0.0, boundaryWork = 0.0, dampingWork = 0.0;
+
+    // Kick and drift; each work term is integrated with the trapezoidal rule over the
+    // drift: half with the forces before it, half with the forces after it.
+#pragma omp parallel for reduction(+ : hourglassWork, externalWork, dampingWork) schedule(static)
     for (Index k = 0; k < nFree; ++k) {
       const Index i = free_[k];
-      p.velocity[i] += halfDt * (p.force[i] / p.mass[i] + g);
+      p.velocity[i] += halfDt * (totalForce(i) / p.mass[i] - c * p.velocity[i]);
       const Vec<D> du = dt_ * p.velocity[i];
       p.displacement[i] += du;
-      externalWork += 0.5 * p.mass[i] * g.dot(du);
-      if (forces_.hourglassEnabled()) hourglassWork += 0.5 * forces_.hourglassForce()[i].dot(du);
+      dampingWork += c * p.mass[i] * p.velocity[i].dot(du);
+      if (hasExternal_) externalWork += 0.5 * external_[i].dot(du);
+      if (hourglass) hourglassWork += 0.5 * forces_.hourglassForce()[i].dot(du);
     }
-    for (Index i : prescribed_) {
-      const Vec<D> du = dt_ * p.velocity[i];
-      p.displacement[i] += du;
-      boundaryWork -= 0.5 * p.force[i].dot(du);
-      if (forces_.hourglassEnabled()) hourglassWork += 0.5 * forces_.hourglassForce()[i].dot(du);
+    for (Index k = 0; k < nPrescribed; ++k) {
+      const Index i = prescribed_[k];
+      step_[k] = prescribedMove(k, time_ + dt_) - p.displacement[i];
+      p.displacement[i] += step_[k];
+      boundaryWork -= 0.5 * p.force[i].dot(step_[k]);
+      if (hourglass) hourglassWork += 0.5 * forces_.hourglassForce()[i].dot(step_[k]);
     }
 
+    time_ += dt_;
     forces_.compute(p.displacement, p.force);
+    if (hasExternal_) computeExternalForces(time_);
 
-#pragma omp parallel for reduction(+ : hourglassWork, externalWork) schedule(static)
+    double kinetic = 0.0;
+#pragma omp parallel for reduction(+ : hourglassWork, externalWork, kinetic) schedule(static)
     for (Index k = 0; k < nFree; ++k) {
       const Index i = free_[k];
       const Vec<D> du = dt_ * p.velocity[i];  // still the mid-step velocity
-      externalWork += 0.5 * p.mass[i] * g.dot(du);
-      if (forces_.hourglassEnabled()) hourglassWork += 0.5 * forces_.hourglassForce()[i].dot(du);
-      p.velocity[i] += halfDt * (p.force[i] / p.mass[i] + g);
+      if (hasExternal_) externalWork += 0.5 * external_[i].dot(du);
+      if (hourglass) hourglassWork += 0.5 * forces_.hourglassForce()[i].dot(du);
+      // Viscous damping taken implicitly in the second kick: stable for any c.
+      p.velocity[i] = (p.velocity[i] + halfDt * totalForce(i) / p.mass[i]) / (1.0 + c * halfDt);
+      kinetic += 0.5 * p.mass[i] * p.velocity[i].squaredNorm();
     }
-    for (Index i : prescribed_) {
-      const Vec<D> du = dt_ * p.velocity[i];
-      boundaryWork -= 0.5 * p.force[i].dot(du);
-      if (forces_.hourglassEnabled()) hourglassWork += 0.5 * forces_.hourglassForce()[i].dot(du);
+    for (Index k = 0; k < nPrescribed; ++k) {
+      const Index i = prescribed_[k];
+      boundaryWork -= 0.5 * p.force[i].dot(step_[k]);
+      if (hourglass) hourglassWork += 0.5 * forces_.hourglassForce()[i].dot(step_[k]);
+      p.velocity[i] = prescribedVelocity(k, time_);
+    }
+
+    if (scene_.damping.kinetic) {
+      if (kinetic < previousKinetic_) {  // just past a peak: take the kinetic energy out
+        for (Index i : free_)
+          p.velocity[i].setZero();
+        dampingWork += kinetic;
+        kinetic = 0.0;
+        ++kineticResets_;
+      }
+      previousKinetic_ = kinetic;
     }
 
     hourglassWorkDone_ += hourglassWork;
     externalWork_ += externalWork;
     boundaryWork_ += boundaryWork;
-    time_ += dt_;
+    damped_ += dampingWork;
     ++steps_;
   }
 
@@ -108,7 +165,36 @@ class Solver {
     e.hourglass = -hourglassWorkDone_;
     e.externalWork = externalWork_;
     e.boundaryWork = boundaryWork_;
+    e.damped = damped_;
     return e;
+  }
+
+  // Out-of-balance force of a quasi-static run: |sum over free particles of (f_int + f_ext)|_2
+  // relative to the size of the forces that hold the body (external loads and reactions).
+  double residualRatio() const {
+    const auto& p = scene_.particles;
+    double residual = 0.0, reference = 0.0;
+    for (Index i : free_) {
+      residual += totalForce(i).squaredNorm();
+      if (hasExternal_) reference += external_[i].squaredNorm();
+    }
+    for (Index i : prescribed_)
+      reference += p.force[i].squaredNorm();
+    return reference > 0.0 ? std::sqrt(residual / reference) : std::sqrt(residual);
+  }
+
+  long kineticDampingResets() const {
+    return kineticResets_;
+  }
+
+  // The longest load or prescription ramp: a static run cannot have converged before it.
+  double rampEnd() const {
+    double end = scene_.gravityRamp.duration;
+    for (const auto& l : scene_.loads)
+      end = std::max(end, l.ramp.duration);
+    for (const auto& r : scene_.prescriptions)
+      end = std::max(end, r.ramp.duration);
+    return end;
   }
 
  private:
@@ -118,16 +204,73 @@ class Solver {
     return Kernel<D>(scene.kernel, scene.supportRadius);
   }
 
+  Vec<D> totalForce(Index i) const {
+    return hasExternal_ ? Vec<D>(scene_.particles.force[i] + external_[i])
+                        : scene_.particles.force[i];
+  }
+
+  void computeExternalForces(double t) {
+    auto& p = scene_.particles;
+    const Vec<D> g = scene_.gravity * scene_.gravityRamp.factor(t);
+    for (Index i = 0; i < p.size(); ++i)
+      external_[i] = p.mass[i] * g;
+    for (const auto& load : scene_.loads) {
+      const double f = load.ramp.factor(t);
+      for (std::size_t k = 0; k < load.particles.size(); ++k)
+        external_[load.particles[k]] += f * load.force[k];
+    }
+  }
+
+  // Displacement of prescribed particle k (index into prescribed_) at time t.
+  Vec<D> prescribedMove(std::size_t k, double t) const {
+    const Index i = prescribed_[k];
+    const auto& p = scene_.particles;
+    if (rule_[k] < 0) return p.displacement[i] + dt_ * p.velocity[i];  // keeps its velocity
+    const auto& rule = scene_.prescriptions[rule_[k]];
+    switch (rule.motion) {
+      case PrescribedMotion::Fixed:
+        return start_[k];
+      case PrescribedMotion::Velocity:
+        return p.displacement[i] + dt_ * rule.value * rule.ramp.factor(t - 0.5 * dt_);
+      case PrescribedMotion::Displacement:
+        return start_[k] + rule.value * rule.ramp.factor(t);
+    }
+    return p.displacement[i];
+  }
+
+  Vec<D> prescribedVelocity(std::size_t k, double t) const {
+    const auto& p = scene_.particles;
+    if (rule_[k] < 0) return p.velocity[prescribed_[k]];
+    const auto& rule = scene_.prescriptions[rule_[k]];
+    switch (rule.motion) {
+      case PrescribedMotion::Fixed:
+        return Vec<D>::Zero();
+      case PrescribedMotion::Velocity:
+        return rule.value * rule.ramp.factor(t);
+      case PrescribedMotion::Displacement:
+        return rule.value * rule.ramp.rate(t);
+    }
+    return Vec<D>::Zero();
+  }
+
   Scene<D>& scene_;
   ReferenceConfiguration<D> ref_;
   TlsphForces<D> forces_;
   std::vector<Index> free_, prescribed_;
+  std::vector<int> rule_;      // per prescribed particle: index into scene.prescriptions, or -1
+  std::vector<Vec<D>> start_;  // per prescribed particle: displacement at the start
+  std::vector<Vec<D>> step_;   // per prescribed particle: its displacement over this step
+  std::vector<Vec<D>> external_;
+  bool hasExternal_ = false;
   double dt_ = 0.0;
   double time_ = 0.0;
   long steps_ = 0;
+  double previousKinetic_ = 0.0;
+  long kineticResets_ = 0;
   double hourglassWorkDone_ = 0.0;  // work done BY the hourglass force
   double externalWork_ = 0.0;
   double boundaryWork_ = 0.0;
+  double damped_ = 0.0;
 };
 
 }  // namespace tlsph
