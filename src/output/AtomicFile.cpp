@@ -1,7 +1,7 @@
 #include "output/AtomicFile.hpp"
 
-#include <system_error>
 #include <unistd.h>
+#include <system_error>
 
 namespace tlsph {
 

@@ -1,0 +1,67 @@
+#include "output/CsvSeries.hpp"
+
+#include <fstream>
+#include <stdexcept>
+
+#include "output/AtomicFile.hpp"
+#include "output/RoundTripNumber.hpp"
+
+namespace tlsph {
+
+CsvSeries::CsvSeries(std::filesystem::path file, std::vector<std::string> columns)
+    : file_(std::move(file)), columns_(std::move(columns)) {
+  if (columns_.empty())
+    throw std::invalid_argument("CSV series " + file_.string() + " has no columns");
+  for (const auto& name : columns_)
+    if (name.empty() || name.front() == '#' || name.find_first_of(",\"\n\r") != std::string::npos)
+      throw std::invalid_argument("CSV column name '" + name + "' in " + file_.string() +
+                                  " is empty or holds a comma, quote, line break or leading #");
+}
+
+void CsvSeries::setPreamble(std::vector<std::string> lines) {
+  preamble_ = std::move(lines);
+}
+
+void CsvSeries::append(const std::vector<double>& row) {
+  if (row.size() != columns_.size())
+    throw std::invalid_argument("CSV row of " + std::to_string(row.size()) + " values for " +
+                                std::to_string(columns_.size()) + " columns in " + file_.string());
+  for (std::size_t c = 0; c < row.size(); ++c) {
+    if (c > 0) rows_ += ',';
+    rows_ += roundTripText(row[c]);
+  }
+  rows_ += '\n';
+  ++rowCount_;
+}
+
+void CsvSeries::flush() {
+  std::string head;
+  for (const auto& line : preamble_) {
+    head += "# ";
+    for (const char c : line) {
+      if (c == '\r') continue;
+      head += c;
+      if (c == '\n') head += "# ";
+    }
+    head += '\n';
+  }
+  for (std::size_t c = 0; c < columns_.size(); ++c) {
+    if (c > 0) head += ',';
+    head += columns_[c];
+  }
+  head += '\n';
+
+  try {
+    writeAtomically(file_, [&](const std::filesystem::path& temporary) {
+      std::ofstream out(temporary, std::ios::binary);
+      out.write(head.data(), static_cast<std::streamsize>(head.size()));
+      out.write(rows_.data(), static_cast<std::streamsize>(rows_.size()));
+      out.close();
+      if (!out) throw std::runtime_error("cannot write CSV file " + file_.string());
+    });
+  } catch (const std::filesystem::filesystem_error& e) {
+    throw std::runtime_error("cannot write CSV file " + file_.string() + ": " + e.what());
+  }
+}
+
+}  // namespace tlsph
