@@ -1,0 +1,110 @@
+// What the writers observe: per-particle output fields assembled from the solver's state,
+// only those the scene asked for.
+#pragma once
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "output/Frame.hpp"
+#include "scene/SceneSetup.hpp"
+#include "tlsph/Solver.hpp"
+
+namespace tlsph {
+
+// Weighted RMS over the neighbours of eps_IJ / |X_IJ| (6.81): the relative mismatch between
+// the pair's current separation and the one F predicts; large where hourglass modes grow.
+template <int D>
+std::vector<double> hourglassError(const ReferenceConfiguration<D>& ref,
+                                   const std::vector<Vec<D>>& u, const std::vector<Mat<D>>& F) {
+  const auto& nb = ref.neighbours;
+  std::vector<double> out(ref.particleCount(), 0.0);
+  for (Index i = 0; i < ref.particleCount(); ++i) {
+    double sum = 0.0, weight = 0.0;
+    for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
+      const Index j = nb.neighbour[k];
+      const Vec<D>& Xij = ref.separation[k];
+      const Vec<D> xij = Xij + (u[i] - u[j]);
+      const double eps = (xij - 0.5 * ((F[i] + F[j]) * Xij)).dot(xij) / xij.norm();
+      sum += ref.kernelValue[k] * std::pow(eps / Xij.norm(), 2);
+      weight += ref.kernelValue[k];
+    }
+    out[i] = weight > 0.0 ? std::sqrt(sum / weight) : 0.0;
+  }
+  return out;
+}
+
+template <int D>
+Frame makeFrame(const SceneSetup<D>& setup, const Solver<D>& solver) {
+  const auto& p = setup.scene.particles;
+  const Index n = p.size();
+  Frame frame;
+  frame.time = solver.time();
+  frame.step = solver.stepCount();
+  frame.points.resize(n);
+  for (Index i = 0; i < n; ++i) {
+    frame.points[i] = {0.0, 0.0, 0.0};
+    const Vec<D> x = p.currentPosition(i);
+    for (int a = 0; a < D; ++a)
+      frame.points[i][a] = x[a];
+  }
+  auto vectorField = [&](const std::string& name, const std::vector<Vec<D>>& v) {
+    PointField f{name, 3, std::vector<double>(3 * n, 0.0)};
+    for (Index i = 0; i < n; ++i)
+      for (int a = 0; a < D; ++a)
+        f.values[3 * i + a] = v[i][a];
+    frame.fields.push_back(std::move(f));
+  };
+  const auto& F = solver.forces().deformationGradient();
+  // The full 3D P and Cauchy stress: in plane strain sigma_33 is not zero.
+  auto piola3 = [&](Index i) {
+    return std::visit(
+        [&](const auto& model) {
+          return model.firstPiolaKirchhoff(embedDeformationGradient<D>(F[i]));
+        },
+        setup.scene.materials[p.material[i]]);
+  };
+  for (const auto& name : setup.output.fields) {
+    if (name == "displacement") {
+      vectorField(name, p.displacement);
+    } else if (name == "velocity") {
+      vectorField(name, p.velocity);
+    } else if (name == "J") {
+      PointField f{name, 1, std::vector<double>(n)};
+      for (Index i = 0; i < n; ++i)
+        f.values[i] = F[i].determinant();
+      frame.fields.push_back(std::move(f));
+    } else if (name == "first_piola" || name == "cauchy_stress" || name == "von_mises") {
+      PointField f{name, name == "von_mises" ? 1 : 9, {}};
+      f.values.resize(f.components * n);
+      for (Index i = 0; i < n; ++i) {
+        const Mat3 F3 = embedDeformationGradient<D>(F[i]);
+        const Mat3 P = piola3(i);
+        Mat3 out = P;
+        if (name != "first_piola") out = P * F3.transpose() / F3.determinant();  // sigma
+        if (name == "von_mises") {
+          const Mat3 dev = out - out.trace() / 3.0 * Mat3::Identity();
+          f.values[i] = std::sqrt(1.5 * dev.squaredNorm());
+        } else {
+          for (int r = 0; r < 3; ++r)
+            for (int c = 0; c < 3; ++c)
+              f.values[9 * i + 3 * r + c] = out(r, c);
+        }
+      }
+      frame.fields.push_back(std::move(f));
+    } else if (name == "hourglass_error") {
+      frame.fields.push_back(
+          PointField{name, 1, hourglassError<D>(solver.reference(), p.displacement, F)});
+    } else if (name == "flags") {
+      frame.flags.push_back(PointFlags{"ghost", setup.ghost});
+      std::vector<std::uint8_t> prescribed(n);
+      for (Index i = 0; i < n; ++i)
+        prescribed[i] = p.motion[i] == Motion::Prescribed;
+      frame.flags.push_back(PointFlags{"prescribed", prescribed});
+      frame.flags.push_back(PointFlags{"body", setup.body});
+    }
+  }
+  return frame;
+}
+
+}  // namespace tlsph

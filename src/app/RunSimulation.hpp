@@ -1,0 +1,188 @@
+// The run loop of `tlsph run`: advance, check, write, report.
+#pragma once
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iomanip>
+#include <memory>
+#include <ostream>
+#include <sstream>
+#include <string>
+
+#include "app/Frames.hpp"
+#include "output/CsvSeries.hpp"
+#include "output/VtuSeriesWriter.hpp"
+#include "scene/SceneSetup.hpp"
+#include "tlsph/Diagnostics.hpp"
+#include "tlsph/Solver.hpp"
+
+namespace tlsph {
+
+struct RunOptions {
+  bool progress = false;  // a live progress line (on a terminal only)
+  std::string command;    // recorded in the CSV preamble, to reproduce the run
+};
+
+enum class RunOutcome { Finished, Converged, NotConverged, Unstable };
+
+struct RunSummary {
+  RunOutcome outcome = RunOutcome::Finished;
+  long steps = 0;
+  double time = 0.0;
+  double timeStep = 0.0;
+  double wallSeconds = 0.0;
+  double residual = 0.0;
+  EnergyBalance energy;
+  std::filesystem::path pvd, energies, probes;
+  std::string message;
+};
+
+template <int D>
+std::vector<std::string> probeColumns(const SceneSetup<D>& setup) {
+  std::vector<std::string> columns = {"time", "step"};
+  const char* axes = "xyz";
+  for (const auto& probe : setup.probes)
+    for (const auto& q : probe.quantities)
+      for (int a = 0; a < D; ++a)
+        columns.push_back(probe.name + "_" + (q == "displacement" ? "u" : "v") + axes[a]);
+  return columns;
+}
+
+template <int D>
+std::vector<double> probeRow(const SceneSetup<D>& setup, const Solver<D>& solver) {
+  const auto& p = setup.scene.particles;
+  std::vector<double> row = {solver.time(), double(solver.stepCount())};
+  for (const auto& probe : setup.probes)
+    for (const auto& q : probe.quantities) {
+      const auto& field = q == "displacement" ? p.displacement : p.velocity;
+      Vec<D> value = Vec<D>::Zero();
+      for (std::size_t k = 0; k < probe.particles.size(); ++k)
+        value += probe.weights[k] * field[probe.particles[k]];
+      for (int a = 0; a < D; ++a)
+        row.push_back(value[a]);
+    }
+  return row;
+}
+
+// onStart sees the solver once it is set up (neighbours, dt), before the first step.
+template <int D, class OnStart>
+RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStart&& onStart) {
+  namespace fs = std::filesystem;
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  Solver<D> solver(setup.scene, setup.solver);
+  onStart(solver);
+  const auto& p = setup.scene.particles;
+  const RunSettings& run = setup.run;
+  const OutputSettings& out = setup.output;
+  const fs::path dir = out.directory;
+
+  std::unique_ptr<VtuSeriesWriter> vtu;
+  if (!out.fields.empty()) vtu = std::make_unique<VtuSeriesWriter>(dir, setup.name);
+  const std::vector<std::string> preamble = {
+      "tlsph scene " + setup.name + " from " + setup.sourceFile, "command: " + options.command,
+      "SI units: s, m, J, kg m/s"};
+  CsvSeries energies(dir / "energies.csv", {"time", "step", "kinetic", "strain", "hourglass",
+                                            "external_work", "boundary_work", "damped", "total",
+                                            "residual", "momentum_x", "momentum_y", "momentum_z"});
+  energies.setPreamble(preamble);
+  std::unique_ptr<CsvSeries> probes;
+  if (!setup.probes.empty()) {
+    probes = std::make_unique<CsvSeries>(dir / "probes.csv", probeColumns(setup));
+    probes->setPreamble(preamble);
+  }
+
+  auto recordSeries = [&] {
+    const EnergyBalance e = solver.energyBalance();
+    Vec3 momentum = Vec3::Zero();
+    momentum.head<D>() = linearMomentum(p);
+    energies.append({solver.time(), double(solver.stepCount()), e.kinetic, e.strain, e.hourglass,
+                     e.externalWork, e.boundaryWork, e.damped, e.total(), solver.residualRatio(),
+                     momentum.x(), momentum.y(), momentum.z()});
+    if (probes) probes->append(probeRow(setup, solver));
+  };
+  long lastFrameStep = -1;
+  auto writeFrame = [&] {
+    if (vtu && lastFrameStep != solver.stepCount()) vtu->write(makeFrame(setup, solver));
+    lastFrameStep = solver.stepCount();
+    energies.flush();
+    if (probes) probes->flush();
+  };
+
+  RunSummary summary;
+  summary.timeStep = solver.timeStep();
+  recordSeries();
+  writeFrame();
+  double nextFrameTime = out.everyTime;
+  auto lastProgress = Clock::now();
+  const double endTime = run.endTime * (1.0 - 1e-12);
+  while (true) {
+    if (solver.time() >= endTime) {
+      summary.outcome = run.quasiStatic ? RunOutcome::NotConverged : RunOutcome::Finished;
+      break;
+    }
+    if (run.maxSteps > 0 && solver.stepCount() >= run.maxSteps) {
+      summary.outcome = run.quasiStatic ? RunOutcome::NotConverged : RunOutcome::Finished;
+      summary.message =
+          "stopped at the step limit [time] max_steps = " + std::to_string(run.maxSteps);
+      break;
+    }
+    solver.step();
+    const long step = solver.stepCount();
+    if (step % run.checkEvery == 0) {
+      if (!stateIsFinite(p)) {
+        summary.outcome = RunOutcome::Unstable;
+        break;
+      }
+      if (run.quasiStatic && solver.time() >= solver.rampEnd() &&
+          solver.residualRatio() < run.tolerance) {
+        summary.outcome = RunOutcome::Converged;
+        break;
+      }
+    }
+    if (step % out.seriesEverySteps == 0) recordSeries();
+    const bool frameDue = out.everySteps > 0 ? step % out.everySteps == 0
+                                             : solver.time() >= nextFrameTime * (1.0 - 1e-12);
+    if (frameDue) {
+      writeFrame();
+      while (out.everyTime > 0 && nextFrameTime <= solver.time() * (1.0 + 1e-12))
+        nextFrameTime += out.everyTime;
+    }
+    if (options.progress && Clock::now() - lastProgress > std::chrono::milliseconds(500)) {
+      lastProgress = Clock::now();
+      const double wall = std::chrono::duration<double>(lastProgress - start).count();
+      const EnergyBalance e = solver.energyBalance();
+      std::fprintf(stderr, "\r\033[Kstep %ld  t = %.4g s of %.4g  dt = %.3g  ", step, solver.time(),
+                   run.endTime, solver.timeStep());
+      if (run.quasiStatic)
+        std::fprintf(stderr, "residual %.3g (target %.3g)  ", solver.residualRatio(),
+                     run.tolerance);
+      const double eta = wall * (run.endTime - solver.time()) / std::max(solver.time(), 1e-300);
+      std::fprintf(stderr, "ETA %s%.0f s  E_kin %.3g  E_strain %.3g", run.quasiStatic ? "<= " : "",
+                   eta, e.kinetic, e.strain);
+      std::fflush(stderr);
+    }
+  }
+  if (options.progress) std::fprintf(stderr, "\r\033[K");
+
+  summary.steps = solver.stepCount();
+  summary.time = solver.time();
+  summary.residual = solver.residualRatio();
+  if (summary.outcome != RunOutcome::Unstable) {
+    recordSeries();
+    writeFrame();
+  } else {
+    energies.flush();
+    if (probes) probes->flush();
+  }
+  summary.energy = solver.energyBalance();
+  summary.wallSeconds = std::chrono::duration<double>(Clock::now() - start).count();
+  if (vtu) summary.pvd = vtu->pvdPath();
+  summary.energies = dir / "energies.csv";
+  if (probes) summary.probes = dir / "probes.csv";
+  return summary;
+}
+
+}  // namespace tlsph

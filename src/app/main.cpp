@@ -1,0 +1,193 @@
+// tlsph: total-Lagrangian SPH for elastic solids.
+//   tlsph run SCENE.ini [--section.key=value ...]
+//   tlsph check SCENE.ini [--section.key=value ...]
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "app/RunSimulation.hpp"
+#include "scene/Config.hpp"
+#include "scene/InputError.hpp"
+#include "scene/SceneBuilder.hpp"
+#include "tlsph/Errors.hpp"
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+namespace {
+
+constexpr const char* kVersion = "0.1.0";
+
+constexpr const char* kUsage = R"(tlsph - total-Lagrangian SPH for elastic solids
+
+usage:
+  tlsph run   SCENE.ini [--section.key=value ...]   run a scene
+  tlsph check SCENE.ini [--section.key=value ...]   validate and print the set-up, do not run
+  tlsph --help | --version
+
+Any key of the scene file can be overridden on the command line, e.g.
+  tlsph run examples/cantilever.ini --time.end=0.5 --scene.dx=0.025
+The scene format is documented in docs/scene-format.md.
+
+run options:
+  --progress / --no-progress   live progress line (default: on when stderr is a terminal
+                               and CI is not set)
+
+exit status: 0 finished (or a static run converged), 1 bad input or set-up, 3 a static
+run did not converge, 4 the run went unstable.
+)";
+
+using namespace tlsph;
+
+template <int D>
+void printSetup(const SceneSetup<D>& setup, const Solver<D>& solver) {
+  const auto& p = setup.scene.particles;
+  const auto& nb = solver.reference().neighbours;
+  Index ghosts = 0, minN = nb.count(0), maxN = 0;
+  for (Index i = 0; i < p.size(); ++i) {
+    ghosts += setup.ghost[i];
+    minN = std::min(minN, nb.count(i));
+    maxN = std::max(maxN, nb.count(i));
+  }
+  std::cout << "scene        " << setup.name << " (" << D << "D" << (D == 2 ? ", plane strain" : "")
+            << ") from " << setup.sourceFile << "\n"
+            << "particles    " << p.size() << " (" << p.size() - ghosts << " body, " << ghosts
+            << " ghost), dx = " << setup.dx << " m\n"
+            << "neighbours   min " << minN << ", mean " << double(nb.pairCount()) / p.size()
+            << ", max " << maxN << " (kernel " << kernelName(setup.scene.kernel)
+            << ", H = " << setup.scene.supportRadius
+            << " m = " << setup.scene.supportRadius / setup.dx << " dx)\n"
+            << "hourglass    alpha = " << setup.scene.hourglassCoefficient
+            << (setup.scene.hourglassCoefficient == 0 ? " (off)" : "") << "\n";
+  for (std::size_t m = 0; m < setup.scene.materials.size(); ++m) {
+    const auto& mat = setup.scene.materials[m];
+    const auto& c = elasticConstants(mat);
+    std::cout << "material     " << setup.materialNames[m] << ": " << materialName(mat)
+              << ", rho0 = " << density(mat) << ", E = " << c.youngsModulus
+              << ", nu = " << c.poissonRatio << ", wave speed " << waveSpeed(mat) << " m/s\n";
+  }
+  for (const auto& line : setup.conditions)
+    std::cout << "condition    " << line << "\n";
+  if (setup.scene.damping.any())
+    std::cout << "damping      viscous " << setup.scene.damping.viscous << " 1/s, kinetic "
+              << (setup.scene.damping.kinetic ? "on" : "off") << "\n";
+  for (const auto& probe : setup.probes)
+    std::cout << "probe        " << probe.name << " at (" << probe.point.transpose() << "), "
+              << (probe.method == ProbeMethod::Nearest ? "nearest particle" : "kernel-interpolated")
+              << "\n";
+  const double steps = setup.run.endTime / solver.timeStep();
+  std::cout << "time         dt = " << solver.timeStep() << " s (CFL " << setup.solver.cfl
+            << "), end " << setup.run.endTime << " s, " << (setup.run.quasiStatic ? "at most " : "")
+            << static_cast<long>(std::ceil(steps)) << " steps"
+            << (setup.run.quasiStatic
+                    ? ", static: stop when residual < " + std::to_string(setup.run.tolerance)
+                    : std::string())
+            << "\n";
+  std::cout << "output       " << setup.output.directory << "/";
+  if (setup.output.fields.empty()) {
+    std::cout << " (CSV only)\n";
+  } else {
+    std::cout << setup.name << ".pvd with";
+    for (const auto& f : setup.output.fields)
+      std::cout << " " << f;
+    std::cout << "\n";
+  }
+}
+
+template <int D>
+int runOrCheck(const Config& config, bool run, bool progress, const std::string& command) {
+  SceneSetup<D> setup = buildScene<D>(config);
+  if (!run) {
+    Scene<D> copy = setup.scene;  // the check builds the solver's set-up without running
+    Solver<D> solver(copy, setup.solver);
+    printSetup(setup, solver);
+    return 0;
+  }
+  RunOptions options;
+  options.progress = progress;
+  options.command = command;
+  const RunSummary s =
+      runSimulation(setup, options, [&](const Solver<D>& solver) { printSetup(setup, solver); });
+  std::cout << "\nsteps " << s.steps << ", simulated " << s.time << " s, wall " << s.wallSeconds
+            << " s (" << double(setup.scene.particles.size()) * s.steps / s.wallSeconds
+            << " particle-steps/s";
+#ifdef _OPENMP
+  std::cout << ", " << omp_get_max_threads() << " threads";
+#endif
+  std::cout << ")\n"
+            << "energy       kinetic " << s.energy.kinetic << ", strain " << s.energy.strain
+            << ", hourglass " << s.energy.hourglass << ", external work " << s.energy.externalWork
+            << ", damped " << s.energy.damped << "\n";
+  if (!s.pvd.empty()) std::cout << "wrote        " << s.pvd.string() << "\n";
+  std::cout << "wrote        " << s.energies.string() << "\n";
+  if (!s.probes.empty()) std::cout << "wrote        " << s.probes.string() << "\n";
+  if (!s.message.empty()) std::cout << s.message << "\n";
+  switch (s.outcome) {
+    case RunOutcome::Finished:
+      std::cout << "finished\n";
+      return 0;
+    case RunOutcome::Converged:
+      std::cout << "converged: residual " << s.residual << " < " << setup.run.tolerance << "\n";
+      return 0;
+    case RunOutcome::NotConverged:
+      std::cout << "NOT converged: residual " << s.residual << " >= " << setup.run.tolerance
+                << " at the end time; raise [time] end or the damping\n";
+      return 3;
+    case RunOutcome::Unstable:
+      std::cerr << "tlsph: the run went unstable (non-finite state) near step " << s.steps
+                << ", t = " << s.time << " s; reduce [time] cfl or check the loads\n";
+      return 4;
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::string> args(argv + 1, argv + argc);
+  if (args.empty() || args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
+    std::cout << kUsage;
+    return args.empty() ? 1 : 0;
+  }
+  if (args[0] == "--version") {
+    std::cout << "tlsph " << kVersion << "\n";
+    return 0;
+  }
+  const std::string verb = args[0];
+  if ((verb != "run" && verb != "check") || args.size() < 2) {
+    std::cerr << "tlsph: expected 'run SCENE.ini' or 'check SCENE.ini'; see tlsph --help\n";
+    return 1;
+  }
+  const char* ci = std::getenv("CI");
+  bool progress = isatty(STDERR_FILENO) && !(ci && *ci);
+  std::vector<std::string> overrides;
+  std::string command = "tlsph";
+  for (const auto& a : args)
+    command += " " + a;
+  for (std::size_t k = 2; k < args.size(); ++k) {
+    if (args[k] == "--progress")
+      progress = true;
+    else if (args[k] == "--no-progress")
+      progress = false;
+    else
+      overrides.push_back(args[k]);
+  }
+  try {
+    const Config config = Config::read(args[1], overrides);
+    const int d = sceneDimension(config);
+    return d == 2 ? runOrCheck<2>(config, verb == "run", progress, command)
+                  : runOrCheck<3>(config, verb == "run", progress, command);
+  } catch (const InputError& e) {
+    std::cerr << "tlsph: " << e.what() << "\n";
+  } catch (const SetupError& e) {
+    std::cerr << "tlsph: " << args[1] << ": set-up error: " << e.what() << "\n";
+  } catch (const std::exception& e) {
+    std::cerr << "tlsph: " << e.what() << "\n";
+  }
+  return 1;
+}

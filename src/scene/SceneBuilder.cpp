@@ -1,0 +1,545 @@
+#include "scene/SceneBuilder.hpp"
+
+#include <cmath>
+#include <filesystem>
+#include <numbers>
+#include <set>
+#include <stdexcept>
+
+#include "geometry/LatticeFill.hpp"
+#include "geometry/Shape.hpp"
+#include "scene/SectionReader.hpp"
+#include "tlsph/Kernel.hpp"
+
+namespace tlsph {
+
+namespace {
+
+const std::vector<std::string> kFieldNames = {"displacement",    "velocity",      "J",
+                                              "von_mises",       "cauchy_stress", "first_piola",
+                                              "hourglass_error", "flags"};
+
+std::string fmt(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+template <int D>
+std::string fmt(const Vec<D>& v) {
+  std::ostringstream s;
+  s << "(" << v.transpose() << ")";
+  return s.str();
+}
+
+template <int D>
+Shape<D> readShape(SectionReader& r, bool allowUnbounded) {
+  std::vector<std::string> kinds = {"box", "cylinder", "ball", "polygon"};
+  if (allowUnbounded) kinds.push_back("half-space");
+  const std::string kind = r.word("shape", std::nullopt, kinds);
+  Shape<D> shape;
+  if (kind == "box") {
+    shape = Box<D>{r.vector<D>("lower"), r.vector<D>("upper")};
+  } else if (kind == "cylinder") {
+    Cylinder<D> c;
+    if constexpr (D == 2) {
+      c.start = r.vector<D>("centre");
+      c.end = c.start;
+    } else {
+      c.start = r.vector<D>("start");
+      c.end = r.vector<D>("end");
+    }
+    c.radius = r.positive("radius");
+    shape = c;
+  } else if (kind == "ball") {
+    shape = Ball<D>{r.vector<D>("centre"), r.positive("radius")};
+  } else if (kind == "polygon") {
+    Polygon<D> p;
+    const auto xy = r.numbers("vertices");
+    if (xy.size() % 2 != 0 || xy.size() < 6)
+      throw r.error("vertices", "expected at least three 'x y' pairs, e.g. 0 0, 1 0, 0 1");
+    for (std::size_t k = 0; k < xy.size(); k += 2)
+      p.vertices.push_back(Vec<2>(xy[k], xy[k + 1]));
+    if constexpr (D == 3) {
+      const std::string axis = r.word("axis", "z", {"x", "y", "z"});
+      p.axis = axis == "x" ? 0 : axis == "y" ? 1 : 2;
+      p.from = r.number("from");
+      p.to = r.number("to");
+    }
+    shape = p;
+  } else {
+    shape = HalfSpace<D>{r.vector<D>("point"), r.vector<D>("normal")};
+  }
+  try {
+    validate(shape);
+  } catch (const std::invalid_argument& e) {
+    throw r.error("shape", e.what());
+  }
+  return shape;
+}
+
+template <int D>
+class Builder {
+ public:
+  explicit Builder(const Config& config) : config_(config) {}
+
+  SceneSetup<D> build() {
+    rejectUnknownSections();
+    readSceneSection();
+    readMaterials();
+    readDiscretisation();
+    fillBodies();
+    readRegions();
+    addClamps();
+    readPrescriptions();
+    readLoads();
+    readInitialConditions();
+    readTimeAndDamping();
+    readOutput();
+    readProbes();
+    return std::move(setup_);
+  }
+
+ private:
+  void readSceneSection() {
+    SectionReader r(config_, "scene");
+    r.allow({"dimension"});
+    setup_.sourceFile = config_.origin();
+    setup_.name = r.word("name", std::filesystem::path(config_.origin()).stem().string());
+    setup_.dx = r.positive("dx");
+    maxParticles_ = static_cast<std::size_t>(r.positive("max_particles", 5e6));
+    r.finish();
+  }
+
+  void readMaterials() {
+    const auto names = config_.namesOf("material");
+    if (names.empty())
+      throw InputError(config_.origin(), "material.NAME", "",
+                       "the scene needs at least one [material.NAME] section");
+    std::vector<std::string> models;
+    for (auto m : materialNames())
+      models.emplace_back(m);
+    for (const auto& name : names) {
+      SectionReader r(config_, "material." + name);
+      const std::string model = r.word("model", std::nullopt, models);
+      const double density = r.positive("density");
+      ElasticConstants c;
+      try {
+        if (r.has("youngs_modulus") || r.has("poisson_ratio")) {
+          c = ElasticConstants::fromYoungPoisson(r.number("youngs_modulus"),
+                                                 r.number("poisson_ratio"));
+        } else if (r.has("lame_lambda")) {
+          c = ElasticConstants::fromLame(r.number("lame_lambda"), r.number("shear_modulus"));
+        } else if (r.has("shear_modulus") && r.has("bulk_modulus")) {
+          c = ElasticConstants::fromShearBulk(r.number("shear_modulus"), r.number("bulk_modulus"));
+        } else {
+          throw r.error("",
+                        "give the elastic constants as youngs_modulus + poisson_ratio, "
+                        "lame_lambda + shear_modulus, or shear_modulus + bulk_modulus");
+        }
+        if (model == "mooney-rivlin") {
+          setup_.scene.materials.push_back(MooneyRivlin(c, density, r.number("c01_fraction", 0.5)));
+        } else {
+          setup_.scene.materials.push_back(makeMaterial(model, c, density));
+        }
+      } catch (const MaterialError& e) {
+        throw r.error("", e.what());
+      }
+      r.allow({"c01_fraction"});
+      r.finish();
+      setup_.materialNames.push_back(name);
+    }
+  }
+
+  void readDiscretisation() {
+    SectionReader k(config_, "kernel");
+    try {
+      setup_.scene.kernel =
+          parseKernelType(k.word("type", "wendland-c2", {"wendland-c2", "cubic-bspline"}));
+    } catch (const std::invalid_argument& e) {
+      throw k.error("type", e.what());
+    }
+    const double ratio = k.positive("support", 2.1);
+    if (ratio < 1.5 || ratio > 5.0)
+      throw k.error("support", "H/dx = " + fmt(ratio) + " is outside the useful range [1.5, 5]");
+    supportRatio_ = ratio;
+    setup_.scene.supportRadius = ratio * setup_.dx;
+    k.finish();
+    SectionReader h(config_, "hourglass");
+    setup_.scene.hourglassCoefficient = h.nonNegative("alpha", 10.0);
+    h.finish();
+  }
+
+  void fillBodies() {
+    const auto names = config_.namesOf("body");
+    if (names.empty())
+      throw InputError(config_.origin(), "body.NAME", "",
+                       "the scene needs at least one [body.NAME] section");
+    std::vector<Shape<D>> shapes;
+    std::vector<std::uint16_t> materialOfBody;
+    for (const auto& name : names) {
+      SectionReader r(config_, "body." + name);
+      shapes.push_back(readShape<D>(r, false));
+      materialOfBody.push_back(materialIndex(r));
+      r.finish();
+      setup_.bodyNames.push_back(name);
+    }
+    std::vector<Vec<D>> points;
+    try {
+      points = fillLattice<D>(shapes, setup_.dx, Vec<D>::Zero(), maxParticles_);
+    } catch (const std::length_error& e) {
+      throw InputError(config_.where("scene", "dx"), "scene", "dx",
+                       std::string(e.what()) +
+                           " (raise [scene] max_particles if the machine has the memory: "
+                           "about 2 kB per particle in 3D)");
+    }
+    if (points.empty())
+      throw InputError(config_.origin(), "body." + names[0], "",
+                       "the bodies contain no lattice point at dx = " + fmt(setup_.dx) +
+                           "; make them larger than dx");
+    const double V = std::pow(setup_.dx, D);
+    auto& p = setup_.scene.particles;
+    for (const auto& X : points) {
+      std::size_t b = 0;
+      while (b + 1 < shapes.size() && !contains(shapes[b], X))
+        ++b;
+      const std::uint16_t m = materialOfBody[b];
+      p.add(X, V, density(setup_.scene.materials[m]) * V, m);
+      setup_.body.push_back(static_cast<std::uint8_t>(b));
+      setup_.ghost.push_back(0);
+    }
+    bodyCount_ = p.size();
+    std::vector<Index> all(bodyCount_);
+    for (Index i = 0; i < bodyCount_; ++i)
+      all[i] = i;
+    setup_.regions["all"] = all;
+  }
+
+  std::uint16_t materialIndex(SectionReader& r) {
+    const auto& names = setup_.materialNames;
+    if (!r.has("material")) {
+      if (names.size() == 1) return 0;
+      throw r.error("material", "missing: the scene has several materials, name one");
+    }
+    const std::string m = r.word("material", std::nullopt, names);
+    return static_cast<std::uint16_t>(std::find(names.begin(), names.end(), m) - names.begin());
+  }
+
+  void readRegions() {
+    const auto& X = setup_.scene.particles.referencePosition;
+    const std::vector<Vec<D>> bodyX(X.begin(), X.begin() + bodyCount_);
+    for (const auto& name : config_.namesOf("region")) {
+      SectionReader r(config_, "region." + name);
+      if (name == "all") throw r.error("", "'all' is a built-in region (every body particle)");
+      const Shape<D> shape = readShape<D>(r, true);
+      r.finish();
+      auto selected = select(shape, bodyX);
+      if (selected.empty())
+        throw r.error("shape",
+                      "the region selects no particle (particles sit at cell centres "
+                      "(n + 1/2) dx; make the region at least one dx thick)");
+      setup_.regions[name] = std::move(selected);
+    }
+  }
+
+  const std::vector<Index>& region(SectionReader& r, const std::string& key = "region") {
+    std::vector<std::string> known;
+    for (const auto& [name, list] : setup_.regions)
+      known.push_back(name);
+    const std::string name = r.word(key, "all", known);
+    return setup_.regions.at(name);
+  }
+
+  void addClamps() {
+    const int layersNeeded = static_cast<int>(std::ceil(supportRatio_ - 1e-9));
+    auto& p = setup_.scene.particles;
+    const auto& X = p.referencePosition;
+    Eigen::AlignedBox<double, D> box;
+    for (Index i = 0; i < bodyCount_; ++i)
+      box.extend(X[i]);
+    std::set<std::string> facesUsed;
+    for (const auto& name : config_.namesOf("clamp")) {
+      SectionReader r(config_, "clamp." + name);
+      std::vector<std::string> faces = {"x-", "x+", "y-", "y+"};
+      if (D == 3) faces.insert(faces.end(), {"z-", "z+"});
+      const std::string face = r.word("face", std::nullopt, faces);
+      if (!facesUsed.insert(face).second)
+        throw r.error("face", "face " + face + " is clamped twice");
+      const long layers = r.integer("layers", layersNeeded);
+      if (layers < layersNeeded)
+        throw r.error("layers", std::to_string(layers) +
+                                    " ghost layers do not fill the kernel support "
+                                    "(H/dx = " +
+                                    fmt(supportRatio_) + " needs " + std::to_string(layersNeeded) +
+                                    ")");
+      r.finish();
+      const int axis = face[0] - 'x';
+      const double sign = face[1] == '-' ? -1.0 : 1.0;
+      const double edge = sign < 0 ? box.min()[axis] : box.max()[axis];
+      Prescription<D> clamp;
+      clamp.name = "clamp." + name;
+      const double V = std::pow(setup_.dx, D);
+      for (Index i = 0; i < bodyCount_; ++i) {
+        if (std::abs(X[i][axis] - edge) > 0.25 * setup_.dx) continue;
+        for (long k = 1; k <= layers; ++k) {
+          Vec<D> G = X[i];
+          G[axis] += sign * k * setup_.dx;
+          const std::uint16_t m = p.material[i];
+          clamp.particles.push_back(
+              p.add(G, V, density(setup_.scene.materials[m]) * V, m, Motion::Prescribed));
+          setup_.body.push_back(setup_.body[i]);
+          setup_.ghost.push_back(1);
+        }
+      }
+      setup_.conditions.push_back("clamp." + name + ": face " + face + ", " +
+                                  std::to_string(layers) + " ghost layers, " +
+                                  std::to_string(clamp.particles.size()) + " ghost particles");
+      setup_.scene.prescriptions.push_back(std::move(clamp));
+    }
+  }
+
+  void readPrescriptions() {
+    auto& p = setup_.scene.particles;
+    for (const auto& name : config_.namesOf("prescribe")) {
+      SectionReader r(config_, "prescribe." + name);
+      Prescription<D> rule;
+      rule.name = "prescribe." + name;
+      rule.particles = region(r);
+      const std::string motion = r.word("motion", "fixed", {"fixed", "velocity", "displacement"});
+      rule.motion = motion == "fixed"      ? PrescribedMotion::Fixed
+                    : motion == "velocity" ? PrescribedMotion::Velocity
+                                           : PrescribedMotion::Displacement;
+      if (rule.motion != PrescribedMotion::Fixed) rule.value = r.vector<D>("value");
+      rule.ramp.duration = r.nonNegative("ramp", 0.0);
+      r.allow({"value"});
+      r.finish();
+      for (Index i : rule.particles) {
+        if (p.motion[i] == Motion::Prescribed)
+          throw r.error("region", "particle " + std::to_string(i) + " at " +
+                                      fmt<D>(p.referencePosition[i]) +
+                                      " is already prescribed by another condition");
+        p.motion[i] = Motion::Prescribed;
+      }
+      setup_.conditions.push_back(
+          rule.name + ": " + motion + " " +
+          (rule.motion == PrescribedMotion::Fixed ? "" : fmt<D>(rule.value)) + " on " +
+          std::to_string(rule.particles.size()) + " particles");
+      setup_.scene.prescriptions.push_back(std::move(rule));
+    }
+  }
+
+  void readLoads() {
+    SectionReader g(config_, "gravity");
+    setup_.scene.gravity = g.vector<D>("acceleration", Vec<D>::Zero());
+    setup_.scene.gravityRamp.duration = g.nonNegative("ramp", 0.0);
+    g.finish();
+    if (!setup_.scene.gravity.isZero())
+      setup_.conditions.push_back("gravity " + fmt<D>(setup_.scene.gravity) + " m/s^2");
+    const auto& p = setup_.scene.particles;
+    for (const auto& name : config_.namesOf("load")) {
+      SectionReader r(config_, "load." + name);
+      Load<D> load;
+      load.name = "load." + name;
+      load.particles = region(r);
+      const std::string type = r.word("type", std::nullopt, {"traction", "force"});
+      const Vec<D> value = r.vector<D>("value");
+      load.ramp.duration = r.nonNegative("ramp", 0.0);
+      r.finish();
+      double volume = 0.0;
+      for (Index i : load.particles)
+        volume += p.volume[i];
+      for (Index i : load.particles) {
+        // (6.76): a traction acts on the area a_I = V_I^((d-1)/d) of each surface particle.
+        const double share =
+            type == "traction" ? std::pow(p.volume[i], (D - 1.0) / D) : p.volume[i] / volume;
+        load.force.push_back(share * value);
+      }
+      setup_.conditions.push_back(load.name + ": " + type + " " + fmt<D>(value) + " on " +
+                                  std::to_string(load.particles.size()) + " particles");
+      setup_.scene.loads.push_back(std::move(load));
+    }
+  }
+
+  void readInitialConditions() {
+    auto& p = setup_.scene.particles;
+    for (const auto& name : config_.namesOf("initial")) {
+      SectionReader r(config_, "initial." + name);
+      const auto& particles = region(r);
+      const std::string profile = r.word("profile", "constant", {"constant", "beam-mode"});
+      if (profile == "constant") {
+        const Vec<D> v = r.vector<D>("velocity");
+        for (Index i : particles)
+          p.velocity[i] = v;
+        setup_.conditions.push_back("initial." + name + ": velocity " + fmt<D>(v));
+      } else {
+        // First cantilever mode shape (DESIGN.md section 6, oscillating plate):
+        // v(s) = amplitude f(s)/f(L) along `direction`, s the distance from `origin` along `axis`.
+        const std::string axisName = r.word("axis", "x", {"x", "y", "z"});
+        const int axis = axisName[0] - 'x';
+        if (axis >= D) throw r.error("axis", "the scene is 2D");
+        const Vec<D> direction = r.vector<D>("direction");
+        if (direction.isZero()) throw r.error("direction", "must not be zero");
+        const double origin = r.number("origin", 0.0);
+        const double length = r.positive("length");
+        const double kL = r.positive("kL", 1.875);
+        double amplitude = 0.0;
+        if (r.has("amplitude_over_c0")) {
+          // c0 = sqrt(K / rho0) of the region's first particle's material (Gray et al. 2001).
+          const auto& m = setup_.scene.materials[p.material[particles.front()]];
+          amplitude = r.number("amplitude_over_c0") *
+                      std::sqrt(elasticConstants(m).bulkModulus / density(m));
+        } else {
+          amplitude = r.number("amplitude");
+        }
+        const double k = kL / length;
+        auto f = [&](double s) {
+          return (std::sin(kL) + std::sinh(kL)) * (std::cos(k * s) - std::cosh(k * s)) -
+                 (std::cos(kL) + std::cosh(kL)) * (std::sin(k * s) - std::sinh(k * s));
+        };
+        const double fL = f(length);
+        for (Index i : particles)
+          p.velocity[i] =
+              amplitude * f(p.referencePosition[i][axis] - origin) / fL * direction.normalized();
+        setup_.conditions.push_back("initial." + name + ": beam-mode, tip speed " + fmt(amplitude) +
+                                    " m/s");
+      }
+      r.allow({"velocity", "amplitude", "amplitude_over_c0", "axis", "direction", "origin",
+               "length", "kL"});
+      r.finish();
+    }
+  }
+
+  void readTimeAndDamping() {
+    SectionReader d(config_, "damping");
+    setup_.scene.damping.viscous = d.nonNegative("viscous", 0.0);
+    setup_.scene.damping.kinetic = d.flag("kinetic", false);
+    d.finish();
+    SectionReader s(config_, "static");
+    setup_.run.quasiStatic = s.flag("enabled", config_.hasSection("static"));
+    setup_.run.tolerance = s.positive("tolerance", 1e-4);
+    setup_.run.checkEvery = std::max(1L, s.integer("check_every", 50));
+    s.finish();
+    SectionReader t(config_, "time");
+    setup_.solver.cfl = t.positive("cfl", kDefaultCfl);
+    setup_.solver.timeStep = t.nonNegative("dt", 0.0);
+    setup_.run.endTime = t.positive("end");
+    setup_.run.maxSteps = t.integer("max_steps", 0);
+    t.finish();
+    if (setup_.run.quasiStatic) {
+      if (!setup_.scene.damping.any())
+        throw InputError(config_.origin(), "static", "enabled",
+                         "a static run needs damping: set [damping] kinetic = true or viscous > 0");
+      if (setup_.scene.prescriptions.empty())
+        throw InputError(config_.origin(), "static", "enabled",
+                         "a static run needs the body held: add a [clamp.NAME] or a "
+                         "[prescribe.NAME] section, or it drifts away under its loads");
+    }
+  }
+
+  void readOutput() {
+    SectionReader o(config_, "output");
+    setup_.output.directory = o.word("directory", "output/" + setup_.name);
+    setup_.output.fields = o.words("fields", {"displacement", "velocity", "von_mises", "flags"});
+    for (const auto& f : setup_.output.fields)
+      if (std::find(kFieldNames.begin(), kFieldNames.end(), f) == kFieldNames.end()) {
+        const std::string hint = closestMatch(f, kFieldNames);
+        std::string all;
+        for (const auto& n : kFieldNames)
+          all += (all.empty() ? "" : ", ") + n;
+        throw o.error("fields", "unknown field '" + f + "'" +
+                                    (hint.empty() ? "" : " (did you mean '" + hint + "'?)") +
+                                    "; fields: " + all + " (or 'none')");
+      }
+    if (setup_.output.fields.size() == 1 && setup_.output.fields[0] == "none")
+      setup_.output.fields.clear();
+    setup_.output.everySteps = o.integer("every_steps", 0);
+    setup_.output.everyTime = o.nonNegative("every_time", 0.0);
+    if (setup_.output.everySteps == 0 && setup_.output.everyTime == 0.0)
+      setup_.output.everyTime = setup_.run.endTime / 20.0;
+    setup_.output.seriesEverySteps = std::max(1L, o.integer("series_every_steps", 20));
+    o.finish();
+  }
+
+  void readProbes() {
+    const auto& p = setup_.scene.particles;
+    const Kernel<D> kernel(setup_.scene.kernel, setup_.scene.supportRadius);
+    for (const auto& name : config_.namesOf("probe")) {
+      SectionReader r(config_, "probe." + name);
+      Probe<D> probe;
+      probe.name = name;
+      probe.point = r.vector<D>("point");
+      probe.method = r.word("method", "nearest", {"nearest", "kernel"}) == "nearest"
+                         ? ProbeMethod::Nearest
+                         : ProbeMethod::Kernel;
+      probe.quantities = r.words("quantities", {"displacement"});
+      for (const auto& q : probe.quantities)
+        if (q != "displacement" && q != "velocity")
+          throw r.error("quantities",
+                        "unknown quantity '" + q + "'; expected displacement, velocity");
+      r.finish();
+      if (probe.method == ProbeMethod::Nearest) {
+        Index best = 0;
+        for (Index i = 1; i < bodyCount_; ++i)
+          if ((p.referencePosition[i] - probe.point).squaredNorm() <
+              (p.referencePosition[best] - probe.point).squaredNorm())
+            best = i;
+        probe.particles = {best};
+        probe.weights = {1.0};
+      } else {
+        // Shepard-normalised kernel interpolation over the reference neighbourhood.
+        double sum = 0.0;
+        for (Index i = 0; i < bodyCount_; ++i) {
+          const double w =
+              kernel.value((p.referencePosition[i] - probe.point).norm()) * p.volume[i];
+          if (w > 0.0) {
+            probe.particles.push_back(i);
+            probe.weights.push_back(w);
+            sum += w;
+          }
+        }
+        if (probe.particles.empty())
+          throw r.error("point", "no particle within the kernel support of " + fmt<D>(probe.point));
+        for (double& w : probe.weights)
+          w /= sum;
+      }
+      setup_.probes.push_back(std::move(probe));
+    }
+  }
+
+  void rejectUnknownSections() {
+    static const std::vector<std::string> kinds = {
+        "scene",    "kernel", "hourglass", "time",  "static",    "damping", "gravity", "output",
+        "material", "body",   "region",    "clamp", "prescribe", "load",    "initial", "probe"};
+    for (const auto& section : config_.sections()) {
+      const std::string kind = section.substr(0, section.find('.'));
+      if (std::find(kinds.begin(), kinds.end(), kind) != kinds.end()) continue;
+      const std::string hint = closestMatch(kind, kinds);
+      throw InputError(config_.origin(), section, "",
+                       "unknown section" + (hint.empty() ? "" : "; did you mean [" + hint + "]?"));
+    }
+  }
+
+  const Config& config_;
+  SceneSetup<D> setup_;
+  std::size_t maxParticles_ = 0;
+  double supportRatio_ = 2.0;
+  Index bodyCount_ = 0;
+};
+
+}  // namespace
+
+int sceneDimension(const Config& config) {
+  SectionReader r(config, "scene");
+  const std::string d = r.word("dimension", std::nullopt, {"2", "3"});
+  return d == "2" ? 2 : 3;
+}
+
+template <int D>
+SceneSetup<D> buildScene(const Config& config) {
+  return Builder<D>(config).build();
+}
+
+template SceneSetup<2> buildScene<2>(const Config&);
+template SceneSetup<3> buildScene<3>(const Config&);
+
+}  // namespace tlsph

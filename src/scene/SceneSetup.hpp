@@ -1,0 +1,61 @@
+// Everything a scene file describes, ready to run: the Scene itself plus how to run it,
+// what to write and where to probe.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "tlsph/Scene.hpp"
+#include "tlsph/Solver.hpp"
+
+namespace tlsph {
+
+struct RunSettings {
+  double endTime = 0.0;
+  long maxSteps = 0;  // 0: no limit
+  bool quasiStatic = false;
+  double tolerance = 1e-4;  // out-of-balance force ratio at which a static run has converged
+  long checkEvery = 50;     // steps between convergence and stability checks
+};
+
+struct OutputSettings {
+  std::string directory;
+  std::vector<std::string> fields;  // VTU point fields; empty: no VTU output
+  long everySteps = 0;              // VTU frame every N steps (0: use everyTime)
+  double everyTime = 0.0;           // VTU frame every T seconds of simulated time
+  long seriesEverySteps = 0;        // energies/probes CSV row every N steps
+};
+
+enum class ProbeMethod { Nearest, Kernel };
+
+template <int D>
+struct Probe {
+  std::string name;
+  Vec<D> point = Vec<D>::Zero();
+  ProbeMethod method = ProbeMethod::Nearest;
+  std::vector<std::string> quantities;  // "displacement", "velocity"
+  // Resolved at setup: the particles and weights whose combination is the probe value.
+  std::vector<Index> particles;
+  std::vector<double> weights;
+};
+
+template <int D>
+struct SceneSetup {
+  std::string name;
+  std::string sourceFile;
+  double dx = 0.0;
+  Scene<D> scene;
+  SolverSettings solver;
+  RunSettings run;
+  OutputSettings output;
+  std::vector<Probe<D>> probes;
+  std::vector<std::string> materialNames;  // by material index
+  std::vector<std::string> bodyNames;      // by body index
+  std::vector<std::uint8_t> body;          // per particle: index into bodyNames
+  std::vector<std::uint8_t> ghost;         // per particle: 1 for clamp ghosts
+  std::map<std::string, std::vector<Index>> regions;
+  std::vector<std::string> conditions;  // one line per condition, for `tlsph check`
+};
+
+}  // namespace tlsph

@@ -1,0 +1,134 @@
+// The `tlsph` program end to end: the cantilever example runs quasi-statically, converges on
+// the Timoshenko tip deflection, and writes a .pvd series that VTK reads back.
+#include <gtest/gtest.h>
+#include <vtkCellData.h>
+#include <vtkDataArray.h>
+#include <vtkPointData.h>
+#include <vtkSmartPointer.h>
+#include <vtkUnstructuredGrid.h>
+#include <vtkXMLUnstructuredGridReader.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Result {
+  int status = -1;
+  std::string output;
+};
+
+Result runProgram(const std::string& arguments, const fs::path& log) {
+  const std::string command =
+      std::string(TLSPH_PROGRAM) + " " + arguments + " > " + log.string() + " 2>&1";
+  Result r;
+  r.status = WEXITSTATUS(std::system(command.c_str()));
+  std::ifstream in(log);
+  std::stringstream text;
+  text << in.rdbuf();
+  r.output = text.str();
+  return r;
+}
+
+// Last data row of a CSV file with '#' preamble lines, as name -> value.
+std::map<std::string, double> lastRow(const fs::path& csv) {
+  std::ifstream in(csv);
+  std::string line, header, last;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    if (header.empty())
+      header = line;
+    else
+      last = line;
+  }
+  std::map<std::string, double> row;
+  std::stringstream h(header), v(last);
+  std::string name, value;
+  while (std::getline(h, name, ',') && std::getline(v, value, ','))
+    row[name] = std::stod(value);
+  return row;
+}
+
+class EndToEnd : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("tlsph_e2e_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path dir_;
+};
+
+}  // namespace
+
+TEST_F(EndToEnd, CantileverConvergesOnTimoshenkoDeflection) {
+  const Result r = runProgram("run " + std::string(TLSPH_SOURCE_DIR) +
+                                  "/examples/cantilever.ini --output.directory=" + dir_.string() +
+                                  " --output.every_time=1",
+                              dir_ / "log.txt");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("converged"), std::string::npos) << r.output;
+  const auto row = lastRow(dir_ / "probes.csv");
+  const double tip = -row.at("tip_uz");
+  const double timoshenko = 0.01516, fem = 0.01501;
+  std::cout << "cantilever tip deflection " << tip << " m (Timoshenko " << timoshenko << ", FEM "
+            << fem << "): " << 100 * (tip - timoshenko) / timoshenko << " %\n";
+  EXPECT_NEAR(tip, timoshenko, 0.05 * timoshenko);
+
+  // The .pvd and its last frame, read back with VTK.
+  const fs::path pvd = dir_ / "cantilever.pvd";
+  ASSERT_TRUE(fs::exists(pvd));
+  std::ifstream in(pvd);
+  std::stringstream text;
+  text << in.rdbuf();
+  std::vector<std::string> files;
+  const std::regex entry("file=\"([^\"]+)\"");
+  const std::string pvdText = text.str();
+  for (std::sregex_iterator it(pvdText.begin(), pvdText.end(), entry), end; it != end; ++it)
+    files.push_back((*it)[1]);
+  ASSERT_GE(files.size(), 2u);
+  auto reader = vtkSmartPointer<vtkXMLUnstructuredGridReader>::New();
+  reader->SetFileName((dir_ / files.back()).c_str());
+  reader->Update();
+  vtkUnstructuredGrid* grid = reader->GetOutput();
+  EXPECT_EQ(grid->GetNumberOfPoints(), 80 * 8 * 8 + 3 * 8 * 8);
+  for (const char* field : {"displacement", "velocity", "von_mises", "J"})
+    EXPECT_NE(grid->GetPointData()->GetArray(field), nullptr) << field;
+  EXPECT_NE(grid->GetPointData()->GetArray("ghost"), nullptr);
+  EXPECT_EQ(grid->GetPointData()->GetArray("displacement")->GetNumberOfComponents(), 3);
+  for (const auto& entry : fs::directory_iterator(dir_))
+    EXPECT_EQ(entry.path().string().find(".tmp"), std::string::npos) << entry.path();
+}
+
+TEST_F(EndToEnd, BadInputExitsNonZeroAndWritesNothing) {
+  const Result r = runProgram("run " + std::string(TLSPH_SOURCE_DIR) +
+                                  "/examples/cantilever.ini --material.rubber.poisson_ratio=0.7 "
+                                  "--output.directory=" +
+                                  (dir_ / "out").string(),
+                              dir_ / "log.txt");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.output.find("[material.rubber]"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir_ / "out"));
+}
+
+TEST_F(EndToEnd, CheckPrintsTheSetUpWithoutRunning) {
+  const Result r = runProgram(
+      "check " + std::string(TLSPH_SOURCE_DIR) +
+          "/examples/oscillating_plate.ini --output.directory=" + (dir_ / "out").string(),
+      dir_ / "log.txt");
+  EXPECT_EQ(r.status, 0) << r.output;
+  for (const char* part : {"particles", "neighbours", "dt =", "wave speed", "prescribe.root"})
+    EXPECT_NE(r.output.find(part), std::string::npos) << part << "\n" << r.output;
+  EXPECT_FALSE(fs::exists(dir_ / "out"));
+}
