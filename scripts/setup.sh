@@ -40,7 +40,9 @@ case "$action" in
     ctest --test-dir "$build_dir" --output-on-failure -j "$jobs"
     ;;
   example)
-    "$build_dir/tlsph_bench" --steps 2000
+    # The 3D cantilever under self-weight (DESIGN.md section 6), run to static equilibrium.
+    "$build_dir/tlsph" run examples/cantilever.ini --output.directory=output/cantilever
+    echo "setup: open $(pwd)/output/cantilever/cantilever.pvd in ParaView"
     ;;
   *)
     echo "usage: scripts/setup.sh [build|test|example]" >&2
