@@ -109,6 +109,13 @@ TEST_F(EndToEnd, CantileverConvergesOnTimoshenkoDeflection) {
   EXPECT_EQ(grid->GetPointData()->GetArray("displacement")->GetNumberOfComponents(), 3);
   for (const auto& entry : fs::directory_iterator(dir_))
     EXPECT_EQ(entry.path().string().find(".tmp"), std::string::npos) << entry.path();
+
+  // The run record scripts read: the particle count and the outcome.
+  std::ifstream recordFile(dir_ / "summary.json");
+  std::stringstream record;
+  record << recordFile.rdbuf();
+  EXPECT_NE(record.str().find("\"particles\": 5312,"), std::string::npos) << record.str();
+  EXPECT_NE(record.str().find("\"outcome\": \"converged\""), std::string::npos) << record.str();
 }
 
 TEST_F(EndToEnd, BadInputExitsNonZeroAndWritesNothing) {

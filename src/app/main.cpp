@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "app/RunRecord.hpp"
 #include "app/RunSimulation.hpp"
 #include "scene/Config.hpp"
 #include "scene/InputError.hpp"
@@ -47,19 +48,16 @@ using namespace tlsph;
 template <int D>
 void printSetup(const SceneSetup<D>& setup, const Solver<D>& solver) {
   const auto& p = setup.scene.particles;
-  const auto& nb = solver.reference().neighbours;
-  Index ghosts = 0, minN = nb.count(0), maxN = 0;
-  for (Index i = 0; i < p.size(); ++i) {
+  const NeighbourStats nb = neighbourStats(solver, p.size());
+  Index ghosts = 0;
+  for (Index i = 0; i < p.size(); ++i)
     ghosts += setup.ghost[i];
-    minN = std::min(minN, nb.count(i));
-    maxN = std::max(maxN, nb.count(i));
-  }
   std::cout << "scene        " << setup.name << " (" << D << "D" << (D == 2 ? ", plane strain" : "")
             << ") from " << setup.sourceFile << "\n"
             << "particles    " << p.size() << " (" << p.size() - ghosts << " body, " << ghosts
             << " ghost), dx = " << setup.dx << " m\n"
-            << "neighbours   min " << minN << ", mean " << double(nb.pairCount()) / p.size()
-            << ", max " << maxN << " (kernel " << kernelName(setup.scene.kernel)
+            << "neighbours   min " << nb.min << ", mean " << nb.mean << ", max " << nb.max
+            << " (kernel " << kernelName(setup.scene.kernel)
             << ", H = " << setup.scene.supportRadius
             << " m = " << setup.scene.supportRadius / setup.dx << " dx)\n"
             << "hourglass    alpha = " << setup.scene.hourglassCoefficient
@@ -111,21 +109,28 @@ int runOrCheck(const Config& config, bool run, bool progress, const std::string&
   RunOptions options;
   options.progress = progress;
   options.command = command;
-  const RunSummary s =
-      runSimulation(setup, options, [&](const Solver<D>& solver) { printSetup(setup, solver); });
+  NeighbourStats neighbours;
+  const RunSummary s = runSimulation(setup, options, [&](const Solver<D>& solver) {
+    printSetup(setup, solver);
+    neighbours = neighbourStats(solver, setup.scene.particles.size());
+  });
+  int threads = 1;
+#ifdef _OPENMP
+  threads = omp_get_max_threads();
+#endif
+  const std::filesystem::path record =
+      std::filesystem::path(setup.output.directory) / "summary.json";
+  writeRunRecord(record, setup, neighbours, s, threads, command, kVersion);
   std::cout << "\nsteps " << s.steps << ", simulated " << s.time << " s, wall " << s.wallSeconds
             << " s (" << double(setup.scene.particles.size()) * s.steps / s.wallSeconds
-            << " particle-steps/s";
-#ifdef _OPENMP
-  std::cout << ", " << omp_get_max_threads() << " threads";
-#endif
-  std::cout << ")\n"
+            << " particle-steps/s, " << threads << (threads == 1 ? " thread" : " threads") << ")\n"
             << "energy       kinetic " << s.energy.kinetic << ", strain " << s.energy.strain
             << ", hourglass " << s.energy.hourglass << ", external work " << s.energy.externalWork
             << ", damped " << s.energy.damped << "\n";
   if (!s.pvd.empty()) std::cout << "wrote        " << s.pvd.string() << "\n";
   std::cout << "wrote        " << s.energies.string() << "\n";
   if (!s.probes.empty()) std::cout << "wrote        " << s.probes.string() << "\n";
+  std::cout << "wrote        " << record.string() << "\n";
   if (!s.message.empty()) std::cout << s.message << "\n";
   switch (s.outcome) {
     case RunOutcome::Finished:

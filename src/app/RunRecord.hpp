@@ -1,0 +1,119 @@
+// summary.json: what a run was and what it cost, for scripts (the validation runner) to read
+// without parsing the console. Written atomically next to the run's other output.
+#pragma once
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "app/RunSimulation.hpp"
+#include "output/AtomicFile.hpp"
+#include "output/RoundTripNumber.hpp"
+
+namespace tlsph {
+
+struct NeighbourStats {
+  Index min = 0, max = 0;
+  double mean = 0.0;
+};
+
+template <int D>
+NeighbourStats neighbourStats(const Solver<D>& solver, Index n) {
+  const auto& nb = solver.reference().neighbours;
+  NeighbourStats s;
+  s.min = n > 0 ? nb.count(0) : 0;
+  for (Index i = 0; i < n; ++i) {
+    s.min = std::min(s.min, nb.count(i));
+    s.max = std::max(s.max, nb.count(i));
+  }
+  s.mean = n > 0 ? double(nb.pairCount()) / n : 0.0;
+  return s;
+}
+
+inline std::string jsonText(const std::string& text) {
+  std::string out = "\"";
+  for (char c : text) {
+    if (c == '"' || c == '\\')
+      out += std::string("\\") + c;
+    else if (static_cast<unsigned char>(c) < 0x20)
+      out += ' ';
+    else
+      out += c;
+  }
+  return out + "\"";
+}
+
+inline std::string jsonNumber(double v) {
+  return std::isfinite(v) ? roundTripText(v) : "null";
+}
+
+inline const char* outcomeName(RunOutcome o) {
+  switch (o) {
+    case RunOutcome::Finished:
+      return "finished";
+    case RunOutcome::Converged:
+      return "converged";
+    case RunOutcome::NotConverged:
+      return "not-converged";
+    case RunOutcome::Unstable:
+      return "unstable";
+  }
+  return "";
+}
+
+template <int D>
+void writeRunRecord(const std::filesystem::path& file, const SceneSetup<D>& setup,
+                    const NeighbourStats& nb, const RunSummary& s, int threads,
+                    const std::string& command, const std::string& version) {
+  Index ghosts = 0;
+  for (auto g : setup.ghost)
+    ghosts += g;
+  const Index n = setup.scene.particles.size();
+  std::ostringstream j;
+  auto field = [&](const char* key, const std::string& value, bool last = false) {
+    j << "  " << jsonText(key) << ": " << value << (last ? "\n" : ",\n");
+  };
+  j << "{\n";
+  field("tlsph_version", jsonText(version));
+  field("scene", jsonText(setup.name));
+  field("source", jsonText(setup.sourceFile));
+  field("command", jsonText(command));
+  field("dimension", std::to_string(D));
+  field("particles", std::to_string(n));
+  field("ghost_particles", std::to_string(ghosts));
+  field("dx", jsonNumber(setup.dx));
+  field("support_over_dx", jsonNumber(setup.scene.supportRadius / setup.dx));
+  field("kernel", jsonText(std::string(kernelName(setup.scene.kernel))));
+  field("hourglass_alpha", jsonNumber(setup.scene.hourglassCoefficient));
+  field("neighbours_min", std::to_string(nb.min));
+  field("neighbours_mean", jsonNumber(nb.mean));
+  field("neighbours_max", std::to_string(nb.max));
+  field("cfl", jsonNumber(setup.solver.cfl));
+  field("dt", jsonNumber(s.timeStep));
+  field("steps", std::to_string(s.steps));
+  field("simulated_time", jsonNumber(s.time));
+  field("wall_seconds", jsonNumber(s.wallSeconds));
+  field("threads", std::to_string(threads));
+  field("particle_steps_per_second",
+        jsonNumber(s.wallSeconds > 0 ? double(n) * s.steps / s.wallSeconds : 0.0));
+  field("outcome", jsonText(outcomeName(s.outcome)));
+  field("residual", jsonNumber(s.residual));
+  field("energy_kinetic", jsonNumber(s.energy.kinetic));
+  field("energy_strain", jsonNumber(s.energy.strain));
+  field("energy_hourglass", jsonNumber(s.energy.hourglass));
+  field("external_work", jsonNumber(s.energy.externalWork));
+  field("damped", jsonNumber(s.energy.damped));
+  field("pvd", jsonText(s.pvd.string()));
+  field("energies", jsonText(s.energies.string()));
+  field("probes", jsonText(s.probes.string()), true);
+  j << "}\n";
+  writeAtomically(file, [&](const std::filesystem::path& tmp) {
+    std::ofstream out(tmp);
+    out << j.str();
+    if (!out.flush()) throw std::runtime_error("cannot write " + tmp.string());
+  });
+}
+
+}  // namespace tlsph
