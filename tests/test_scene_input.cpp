@@ -142,6 +142,14 @@ TEST(SceneInput, CommandLineOverrides) {
   expectError(errorOf(kGood, {"--timeend"}), {"command line", "--section.key=value"});
 }
 
+TEST(SceneInput, OutputFieldsNone) {
+  const SceneSetup<2> setup =
+      buildScene<2>(Config::parse(kGood, "scene.ini", {"--output.fields=none"}));
+  EXPECT_TRUE(setup.output.fields.empty());
+  expectError(errorOf(kGood, {"--output.fields=displacment"}),
+              {"[output]", "fields", "did you mean 'displacement'"});
+}
+
 TEST(SceneInput, UnnamedNamedSection) {
   expectError(errorOf(kGood + "[material]\nmodel = neo-hookean\n"), {"[material]", "need a name"});
 }

@@ -440,6 +440,8 @@ class Builder {
     SectionReader o(config_, "output");
     setup_.output.directory = o.word("directory", "output/" + setup_.name);
     setup_.output.fields = o.words("fields", {"displacement", "velocity", "von_mises", "flags"});
+    if (setup_.output.fields.size() == 1 && setup_.output.fields[0] == "none")
+      setup_.output.fields.clear();
     for (const auto& f : setup_.output.fields)
       if (std::find(kFieldNames.begin(), kFieldNames.end(), f) == kFieldNames.end()) {
         const std::string hint = closestMatch(f, kFieldNames);
@@ -450,8 +452,6 @@ class Builder {
                                     (hint.empty() ? "" : " (did you mean '" + hint + "'?)") +
                                     "; fields: " + all + " (or 'none')");
       }
-    if (setup_.output.fields.size() == 1 && setup_.output.fields[0] == "none")
-      setup_.output.fields.clear();
     setup_.output.everySteps = o.integer("every_steps", 0);
     setup_.output.everyTime = o.nonNegative("every_time", 0.0);
     if (setup_.output.everySteps == 0 && setup_.output.everyTime == 0.0)
