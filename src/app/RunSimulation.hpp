@@ -53,13 +53,20 @@ std::vector<std::string> probeColumns(const SceneSetup<D>& setup) {
 template <int D>
 std::vector<double> probeRow(const SceneSetup<D>& setup, const Solver<D>& solver) {
   const auto& p = setup.scene.particles;
+  const auto& F = solver.forces().deformationGradient();
   std::vector<double> row = {solver.time(), double(solver.stepCount())};
   for (const auto& probe : setup.probes)
     for (const auto& q : probe.quantities) {
-      const auto& field = q == "displacement" ? p.displacement : p.velocity;
+      const bool displacement = q == "displacement";
+      const auto& field = displacement ? p.displacement : p.velocity;
+      const bool firstOrder = displacement && !probe.offsets.empty();
       Vec<D> value = Vec<D>::Zero();
-      for (std::size_t k = 0; k < probe.particles.size(); ++k)
-        value += probe.weights[k] * field[probe.particles[k]];
+      for (std::size_t k = 0; k < probe.particles.size(); ++k) {
+        const Index j = probe.particles[k];
+        Vec<D> u = field[j];
+        if (firstOrder) u += (F[j] - Mat<D>::Identity()) * probe.offsets[k];  // u(X_J + d)
+        value += probe.weights[k] * u;
+      }
       for (int a = 0; a < D; ++a)
         row.push_back(value[a]);
     }

@@ -486,7 +486,9 @@ class Builder {
         probe.particles = {best};
         probe.weights = {1.0};
       } else {
-        // Shepard-normalised kernel interpolation over the reference neighbourhood.
+        // Shepard-normalised kernel interpolation over the reference neighbourhood; each
+        // particle's displacement is carried to the point with its own gradient F - 1, so the
+        // probe is exact for linear fields even on the surface (a beam's tip).
         double sum = 0.0;
         for (Index i = 0; i < bodyCount_; ++i) {
           const double w =
@@ -494,6 +496,7 @@ class Builder {
           if (w > 0.0) {
             probe.particles.push_back(i);
             probe.weights.push_back(w);
+            probe.offsets.push_back(probe.point - p.referencePosition[i]);
             sum += w;
           }
         }

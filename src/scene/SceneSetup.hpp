@@ -38,6 +38,7 @@ struct Probe {
   // Resolved at setup: the particles and weights whose combination is the probe value.
   std::vector<Index> particles;
   std::vector<double> weights;
+  std::vector<Vec<D>> offsets;  // Kernel: point - X_J, for the first-order correction
 };
 
 template <int D>

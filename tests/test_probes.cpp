@@ -1,0 +1,74 @@
+// Probes: a kernel probe carries each particle's displacement to the probe point with its
+// deformation gradient, so it is exact for affine fields, also at a surface point outside the
+// particle cloud's hull (a beam tip); a nearest probe reports the nearest particle's value.
+#include <gtest/gtest.h>
+
+#include "app/RunSimulation.hpp"
+#include "scene/Config.hpp"
+#include "scene/SceneBuilder.hpp"
+
+using namespace tlsph;
+
+namespace {
+
+const std::string kBeam = R"(
+[scene]
+dimension = 2
+dx = 0.01
+[material.m]
+model = neo-hookean
+density = 1000
+youngs_modulus = 1e6
+poisson_ratio = 0.3
+[body.bar]
+shape = box
+lower = 0 0
+upper = 0.2 0.04
+[time]
+end = 0.01
+[probe.tip]
+point = 0.2 0.02
+method = kernel
+quantities = displacement velocity
+[probe.corner]
+point = 0.2 0.04
+method = kernel
+[probe.near]
+point = 0.2 0.02
+method = nearest
+)";
+
+}  // namespace
+
+TEST(Probes, KernelProbeIsExactForAffineFieldsAtSurfacePoints) {
+  SceneSetup<2> setup = buildScene<2>(Config::parse(kBeam, "beam.ini"));
+  Mat<2> G;
+  G << 0.03, -0.2, 0.11, 0.05;
+  const Vec<2> c(0.001, -0.002);
+  auto& p = setup.scene.particles;
+  for (Index i = 0; i < p.size(); ++i) {
+    p.displacement[i] = c + G * p.referencePosition[i];
+    p.velocity[i] = Vec<2>(1.0, 2.0);
+  }
+  Solver<2> solver(setup.scene, setup.solver);  // computes F for the current displacement
+  const auto row = probeRow(setup, solver);
+  const auto columns = probeColumns(setup);
+  ASSERT_EQ(row.size(), columns.size());
+  auto value = [&](const std::string& column) {
+    const auto at = std::find(columns.begin(), columns.end(), column);
+    EXPECT_NE(at, columns.end()) << column;
+    return row[at - columns.begin()];
+  };
+  const Vec<2> tip = c + G * Vec<2>(0.2, 0.02), corner = c + G * Vec<2>(0.2, 0.04);
+  EXPECT_NEAR(value("tip_ux"), tip.x(), 1e-14);
+  EXPECT_NEAR(value("tip_uy"), tip.y(), 1e-14);
+  EXPECT_NEAR(value("corner_ux"), corner.x(), 1e-14);
+  EXPECT_NEAR(value("corner_uy"), corner.y(), 1e-14);
+  EXPECT_NEAR(value("tip_vx"), 1.0, 1e-14);  // velocities: Shepard average
+  EXPECT_NEAR(value("tip_vy"), 2.0, 1e-14);
+  // The nearest particle to (0.2, 0.02) sits half a spacing inside the tip, at (0.195, 0.015) or
+  // (0.195, 0.025): its own value, not the tip's.
+  const double nearX = value("near_ux");
+  const Vec<2> a = c + G * Vec<2>(0.195, 0.015), b = c + G * Vec<2>(0.195, 0.025);
+  EXPECT_TRUE(std::abs(nearX - a.x()) < 1e-14 || std::abs(nearX - b.x()) < 1e-14) << nearX;
+}
