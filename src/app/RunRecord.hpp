@@ -10,6 +10,7 @@
 
 #include "app/RunSimulation.hpp"
 #include "output/AtomicFile.hpp"
+#include "output/JsonText.hpp"
 #include "output/RoundTripNumber.hpp"
 
 namespace tlsph {
@@ -30,23 +31,6 @@ NeighbourStats neighbourStats(const Solver<D>& solver, Index n) {
   }
   s.mean = n > 0 ? double(nb.pairCount()) / n : 0.0;
   return s;
-}
-
-inline std::string jsonText(const std::string& text) {
-  std::string out = "\"";
-  for (char c : text) {
-    if (c == '"' || c == '\\')
-      out += std::string("\\") + c;
-    else if (static_cast<unsigned char>(c) < 0x20)
-      out += ' ';
-    else
-      out += c;
-  }
-  return out + "\"";
-}
-
-inline std::string jsonNumber(double v) {
-  return std::isfinite(v) ? roundTripText(v) : "null";
 }
 
 inline const char* outcomeName(RunOutcome o) {

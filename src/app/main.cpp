@@ -1,6 +1,7 @@
 // tlsph: total-Lagrangian SPH for elastic solids.
 //   tlsph run SCENE.ini [--section.key=value ...]
 //   tlsph check SCENE.ini [--section.key=value ...]
+//   tlsph compare RUN FEM.vtu [options]
 #include <unistd.h>
 
 #include <algorithm>
@@ -9,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "app/CompareCommand.hpp"
 #include "app/RunRecord.hpp"
 #include "app/RunSimulation.hpp"
 #include "scene/Config.hpp"
@@ -29,6 +31,8 @@ constexpr const char* kUsage = R"(tlsph - total-Lagrangian SPH for elastic solid
 usage:
   tlsph run   SCENE.ini [--section.key=value ...]   run a scene
   tlsph check SCENE.ini [--section.key=value ...]   validate and print the set-up, do not run
+  tlsph compare RUN FEM.vtu [options]               errors against an FEM solution, field by
+                                                    field (tlsph compare --help)
   tlsph --help | --version
 
 Any key of the scene file can be overridden on the command line, e.g.
@@ -76,7 +80,8 @@ void printSetup(const SceneSetup<D>& setup, const Solver<D>& solver) {
               << (setup.scene.damping.kinetic ? "on" : "off") << "\n";
   for (const auto& probe : setup.probes)
     std::cout << "probe        " << probe.name << " at (" << probe.point.transpose() << "), "
-              << (probe.method == ProbeMethod::Nearest ? "nearest particle" : "kernel-interpolated")
+              << (probe.method == ProbeMethod::Nearest ? "nearest particle"
+                                                       : "kernel-interpolated, first order")
               << "\n";
   const double steps = setup.run.endTime / solver.timeStep();
   std::cout << "time         dt = " << solver.timeStep() << " s (CFL " << setup.solver.cfl
@@ -164,8 +169,10 @@ int main(int argc, char** argv) {
     return 0;
   }
   const std::string verb = args[0];
+  if (verb == "compare") return runCompare({args.begin() + 1, args.end()});
   if ((verb != "run" && verb != "check") || args.size() < 2) {
-    std::cerr << "tlsph: expected 'run SCENE.ini' or 'check SCENE.ini'; see tlsph --help\n";
+    std::cerr << "tlsph: expected 'run SCENE.ini', 'check SCENE.ini' or 'compare RUN FEM.vtu'; "
+                 "see tlsph --help\n";
     return 1;
   }
   const char* ci = std::getenv("CI");
