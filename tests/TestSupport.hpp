@@ -50,7 +50,8 @@ class ForceEvaluator {
       : scene_(std::move(scene)),
         ref_(buildReferenceConfiguration<D>(
             scene_.particles.referencePosition, scene_.particles.volume,
-            Kernel<D>(scene_.kernel, scene_.supportRadius), scene_.periodicBox)),
+            Kernel<D>(scene_.kernel, scene_.supportRadius), scene_.periodicBox,
+            scene_.gradientCorrection)),
         forces_(ref_, scene_.materials, scene_.particles.material, scene_.particles.volume,
                 scene_.hourglassCoefficient) {}
   ForceEvaluator(const ForceEvaluator&) = delete;

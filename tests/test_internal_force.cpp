@@ -20,13 +20,15 @@ std::vector<Vec<D>> randomDeformation(const ForceEvaluator<D>& eval, double dx, 
 }
 
 template <int D>
-void expectForceIsMinusEnergyGradient(const std::string& material, std::uint32_t seed) {
+void expectForceIsMinusEnergyGradient(const std::string& material, std::uint32_t seed,
+                                      GradientCorrection correction = GradientCorrection::Linear) {
   std::mt19937 rng(seed);
   const double dx = 0.01;
   std::array<int, D> counts;
   counts.fill(D == 2 ? 6 : 4);
-  ForceEvaluator<D> eval(
-      sceneOf<D>(perturbedBlock<D>(counts, dx, 0.2, rng), dx, 2.5, testMaterial(material)));
+  auto scene = sceneOf<D>(perturbedBlock<D>(counts, dx, 0.2, rng), dx, 2.5, testMaterial(material));
+  scene.gradientCorrection = correction;
+  ForceEvaluator<D> eval(std::move(scene));
   auto u = randomDeformation(eval, dx, rng);
   const auto f = eval.force(u);
   double fmax = 0.0;
@@ -51,13 +53,16 @@ void expectForceIsMinusEnergyGradient(const std::string& material, std::uint32_t
 }
 
 template <int D>
-void expectZeroTotalForce(const std::string& material, double alpha, std::uint32_t seed) {
+void expectZeroTotalForce(const std::string& material, double alpha, std::uint32_t seed,
+                          GradientCorrection correction = GradientCorrection::Linear) {
   std::mt19937 rng(seed);
   const double dx = 0.01;
   std::array<int, D> counts;
   counts.fill(D == 2 ? 7 : 4);
-  ForceEvaluator<D> eval(
-      sceneOf<D>(perturbedBlock<D>(counts, dx, 0.2, rng), dx, 2.5, testMaterial(material), alpha));
+  auto scene =
+      sceneOf<D>(perturbedBlock<D>(counts, dx, 0.2, rng), dx, 2.5, testMaterial(material), alpha);
+  scene.gradientCorrection = correction;
+  ForceEvaluator<D> eval(std::move(scene));
   const auto f = eval.force(randomDeformation(eval, dx, rng));
   Vec<D> total = Vec<D>::Zero();
   double scale = 0.0;
@@ -87,6 +92,17 @@ TEST_P(InternalForce, ConservesLinearMomentum3D) {
 TEST_P(InternalForce, ConservesLinearMomentumWithHourglass) {
   expectZeroTotalForce<2>(GetParam(), 5.0, 25);
   expectZeroTotalForce<3>(GetParam(), 5.0, 26);
+}
+// The quadratic gradient correction changes F, so the force must follow it: still -dE/du.
+TEST_P(InternalForce, IsMinusEnergyGradientQuadraticCorrection2D) {
+  expectForceIsMinusEnergyGradient<2>(GetParam(), 27, GradientCorrection::Quadratic);
+}
+TEST_P(InternalForce, IsMinusEnergyGradientQuadraticCorrection3D) {
+  expectForceIsMinusEnergyGradient<3>(GetParam(), 28, GradientCorrection::Quadratic);
+}
+TEST_P(InternalForce, ConservesLinearMomentumQuadraticCorrection) {
+  expectZeroTotalForce<2>(GetParam(), 5.0, 29, GradientCorrection::Quadratic);
+  expectZeroTotalForce<3>(GetParam(), 5.0, 30, GradientCorrection::Quadratic);
 }
 
 INSTANTIATE_TEST_SUITE_P(Materials, InternalForce,

@@ -70,6 +70,7 @@ void writeRunRecord(const std::filesystem::path& file, const SceneSetup<D>& setu
   field("dx", jsonNumber(setup.dx));
   field("support_over_dx", jsonNumber(setup.scene.supportRadius / setup.dx));
   field("kernel", jsonText(std::string(kernelName(setup.scene.kernel))));
+  field("gradient_correction", jsonText(gradientCorrectionName(setup.scene.gradientCorrection)));
   field("hourglass_alpha", jsonNumber(setup.scene.hourglassCoefficient));
   field("neighbours_min", std::to_string(nb.min));
   field("neighbours_mean", jsonNumber(nb.mean));

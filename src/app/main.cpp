@@ -63,7 +63,8 @@ void printSetup(const SceneSetup<D>& setup, const Solver<D>& solver) {
             << "neighbours   min " << nb.min << ", mean " << nb.mean << ", max " << nb.max
             << " (kernel " << kernelName(setup.scene.kernel)
             << ", H = " << setup.scene.supportRadius
-            << " m = " << setup.scene.supportRadius / setup.dx << " dx)\n"
+            << " m = " << setup.scene.supportRadius / setup.dx << " dx, "
+            << gradientCorrectionName(setup.scene.gradientCorrection) << " gradient correction)\n"
             << "hourglass    alpha = " << setup.scene.hourglassCoefficient
             << (setup.scene.hourglassCoefficient == 0 ? " (off)" : "") << "\n";
   for (std::size_t m = 0; m < setup.scene.materials.size(); ++m) {

@@ -163,6 +163,8 @@ class Builder {
     if (ratio < 1.5 || ratio > 5.0)
       throw k.error("support", "H/dx = " + fmt(ratio) + " is outside the useful range [1.5, 5]");
     supportRatio_ = ratio;
+    setup_.scene.gradientCorrection =
+        parseGradientCorrection(k.word("correction", "quadratic", {"linear", "quadratic"}));
     setup_.scene.supportRadius = ratio * setup_.dx;
     k.finish();
     SectionReader h(config_, "hourglass");

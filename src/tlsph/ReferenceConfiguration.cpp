@@ -1,36 +1,87 @@
 #include "tlsph/ReferenceConfiguration.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
 
 #include "tlsph/Errors.hpp"
 
 namespace tlsph {
 
+const char* gradientCorrectionName(GradientCorrection c) {
+  return c == GradientCorrection::Linear ? "linear" : "quadratic";
+}
+
+GradientCorrection parseGradientCorrection(const std::string& name) {
+  if (name == "linear") return GradientCorrection::Linear;
+  if (name == "quadratic") return GradientCorrection::Quadratic;
+  throw std::invalid_argument("unknown gradient correction '" + name +
+                              "'; expected linear or quadratic");
+}
+
+namespace {
+
+// Monomials of a quadratic fit through the particle's own value, in d = Delta / H:
+// d_1..d_D, then d_a d_b for a <= b.
 template <int D>
-ReferenceConfiguration<D> buildReferenceConfiguration(const std::vector<Vec<D>>& X,
-                                                      const std::vector<double>& volume,
-                                                      const Kernel<D>& kernel,
-                                                      const PeriodicBox<D>& box,
-                                                      double minCorrectionCondition) {
+constexpr int kQuadraticTerms = D + D*(D + 1) / 2;
+
+template <int D>
+Eigen::Matrix<double, kQuadraticTerms<D>, 1> quadraticBasis(const Vec<D>& d) {
+  Eigen::Matrix<double, kQuadraticTerms<D>, 1> p;
+  int t = 0;
+  for (int a = 0; a < D; ++a)
+    p[t++] = d[a];
+  for (int a = 0; a < D; ++a)
+    for (int b = a; b < D; ++b)
+      p[t++] = d[a] * d[b];
+  return p;
+}
+
+std::string conditionMessage(Index i, const std::string& position, Index neighbours,
+                             const char* what, double condition, double needed, int D) {
+  std::ostringstream msg;
+  msg << "particle " << i << " at (" << position << ") has " << neighbours << " neighbours and its "
+      << what << " is " << (condition == 0.0 ? "singular" : "badly conditioned")
+      << " (reciprocal condition number " << condition << ", need at least " << needed
+      << "); its neighbours must span all " << D
+      << " directions: increase the kernel support H/dx or check the geometry";
+  return msg.str();
+}
+
+}  // namespace
+
+template <int D>
+ReferenceConfiguration<D> buildReferenceConfiguration(
+    const std::vector<Vec<D>>& X, const std::vector<double>& volume, const Kernel<D>& kernel,
+    const PeriodicBox<D>& box, GradientCorrection correction, double minCorrectionCondition) {
   ReferenceConfiguration<D> ref;
+  ref.correction = correction;
   ref.neighbours = buildNeighbourList<D>(X, kernel.supportRadius(), box);
+  const auto& nb = ref.neighbours;
   const Index n = ref.particleCount();
-  const Index pairs = ref.neighbours.pairCount();
+  const Index pairs = nb.pairCount();
   ref.separation.resize(pairs);
   ref.weightedGradient.resize(pairs);
   ref.kernelValue.resize(pairs);
+  ref.correctedGradient.resize(pairs);
+  ref.reverseGradient.resize(pairs);
+  if (correction == GradientCorrection::Quadratic) ref.linearGradient.resize(pairs);
   ref.correctionInverse.resize(n);
   ref.gradientSum.resize(n);
+  ref.correctedGradientSum.resize(n);
+  const double H = kernel.supportRadius();
 
-  std::vector<double> condition(n);
+  std::vector<double> condition(n), fitCondition(n, 1.0);
 #pragma omp parallel for schedule(static)
   for (Index i = 0; i < n; ++i) {
     Mat<D> L = Mat<D>::Zero();
     Vec<D> s = Vec<D>::Zero();
-    for (Index k = ref.neighbours.offset[i]; k < ref.neighbours.offset[i + 1]; ++k) {
-      const Index j = ref.neighbours.neighbour[k];
+    for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
+      const Index j = nb.neighbour[k];
       const Vec<D> Xij = box.separation(X[i], X[j]);
       const Vec<D> w = volume[j] * kernel.gradient(Xij);
       ref.separation[k] = Xij;
@@ -46,29 +97,92 @@ ReferenceConfiguration<D> buildReferenceConfiguration(const std::vector<Vec<D>>&
     const double product = L.norm() * ref.correctionInverse[i].norm();
     condition[i] = det != 0.0 && std::isfinite(product) ? 1.0 / product : 0.0;
     ref.gradientSum[i] = s;
+
+    Vec<D> G = Vec<D>::Zero();
+    if (correction == GradientCorrection::Linear) {
+      const Mat<D> LinvT = ref.correctionInverse[i].transpose();
+      for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
+        ref.correctedGradient[k] = LinvT * ref.weightedGradient[k];  // (6.69)
+        G += ref.correctedGradient[k];
+      }
+    } else {
+      // Weighted least squares: f_J - f_I ~ c . p(Delta_J / H), weights V_J W_IJ; the
+      // gradient is c_1..c_D / H, linear in the f_J: g_IJ = V_J W_IJ [M^{-1} p_J]_{1..D} / H.
+      constexpr int T = kQuadraticTerms<D>;
+      using Moment = Eigen::Matrix<double, T, T>;
+      Moment M = Moment::Zero();
+      for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
+        const auto p = quadraticBasis<D>(-ref.separation[k] / H);
+        M.noalias() += (volume[nb.neighbour[k]] * ref.kernelValue[k]) * p * p.transpose();
+      }
+      // Dynamic size: set-up cost only.
+      const Mat<D> LinvT = ref.correctionInverse[i].transpose();
+      for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k)
+        ref.linearGradient[k] = LinvT * ref.weightedGradient[k];
+      const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen{Eigen::MatrixXd(M)};
+      const double largest = eigen.eigenvalues().maxCoeff();
+      fitCondition[i] =
+          largest > 0.0 ? std::max(0.0, eigen.eigenvalues().minCoeff()) / largest : 0.0;
+      if (fitCondition[i] > 0.0) {
+        const Moment Minv =
+            Moment(eigen.eigenvectors() * eigen.eigenvalues().cwiseInverse().asDiagonal() *
+                   eigen.eigenvectors().transpose());
+        for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
+          const auto p = quadraticBasis<D>(-ref.separation[k] / H);
+          const Eigen::Matrix<double, T, 1> c = Minv * p;
+          ref.correctedGradient[k] =
+              (volume[nb.neighbour[k]] * ref.kernelValue[k] / H) * c.template head<D>();
+          G += ref.correctedGradient[k];
+        }
+      }
+    }
+    ref.correctedGradientSum[i] = G;
   }
 
   for (Index i = 0; i < n; ++i) {
-    if (condition[i] >= minCorrectionCondition) continue;
-    std::ostringstream msg;
-    msg << "particle " << i << " at (" << X[i].transpose() << ") has " << ref.neighbours.count(i)
-        << " neighbours and its correction tensor L is "
-        << (condition[i] == 0.0 ? "singular" : "badly conditioned")
-        << " (reciprocal condition number " << condition[i] << ", need at least "
-        << minCorrectionCondition << "); its neighbours must span all " << D
-        << " directions: increase the kernel support H/dx or check the geometry";
-    throw SetupError(msg.str());
+    std::ostringstream position;
+    if (condition[i] < minCorrectionCondition) {
+      position << X[i].transpose();
+      throw SetupError(conditionMessage(i, position.str(), nb.count(i), "correction tensor L",
+                                        condition[i], minCorrectionCondition, D));
+    }
+    // The fit's moment matrix is a Gram matrix of monomials: its eigenvalue ratio is the
+    // square of a condition number, so the bar is squared too.
+    const double fitNeeded = minCorrectionCondition * minCorrectionCondition;
+    if (fitCondition[i] < fitNeeded) {
+      position << X[i].transpose();
+      throw SetupError(conditionMessage(i, position.str(), nb.count(i),
+                                        "quadratic-fit moment matrix", fitCondition[i], fitNeeded,
+                                        D) +
+                       " (or use [kernel] correction = linear)");
+    }
   }
+
+  // t_IJ = (V_J / V_I) g_JI: the full lists are symmetric and sorted, so (J, I) is found by
+  // binary search in J's list.
+#pragma omp parallel for schedule(static)
+  for (Index i = 0; i < n; ++i)
+    for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
+      const Index j = nb.neighbour[k];
+      const auto first = nb.neighbour.begin() + nb.offset[j];
+      const auto last = nb.neighbour.begin() + nb.offset[j + 1];
+      const auto at = std::lower_bound(first, last, i);
+      if (at == last || *at != i) throw SetupError("internal: neighbour lists are not symmetric");
+      const Index back = static_cast<Index>(at - nb.neighbour.begin());
+      ref.reverseGradient[k] = (volume[j] / volume[i]) * ref.correctedGradient[back];
+    }
   return ref;
 }
 
 template ReferenceConfiguration<2> buildReferenceConfiguration<2>(const std::vector<Vec<2>>&,
                                                                   const std::vector<double>&,
                                                                   const Kernel<2>&,
-                                                                  const PeriodicBox<2>&, double);
+                                                                  const PeriodicBox<2>&,
+                                                                  GradientCorrection, double);
 template ReferenceConfiguration<3> buildReferenceConfiguration<3>(const std::vector<Vec<3>>&,
                                                                   const std::vector<double>&,
                                                                   const Kernel<3>&,
-                                                                  const PeriodicBox<3>&, double);
+                                                                  const PeriodicBox<3>&,
+                                                                  GradientCorrection, double);
 
 }  // namespace tlsph

@@ -2,6 +2,7 @@
 // neighbour lists, per-pair kernel data and the inverse correction tensors L_I^{-1}.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "tlsph/Kernel.hpp"
@@ -11,6 +12,16 @@
 
 namespace tlsph {
 
+// How the gradient of a particle field is corrected (DESIGN.md section 2, and README):
+//   Linear: (6.69), gradW times L_I^{-1}; exact for linear fields.
+//   Quadratic: the gradient of a kernel-weighted least-squares quadratic fit through the
+//   particle's value; exact for quadratic fields, so also on free surfaces in bending, where
+//   the linear correction reads the strain at the neighbourhood's centroid, inside the body.
+enum class GradientCorrection { Linear, Quadratic };
+
+const char* gradientCorrectionName(GradientCorrection c);
+GradientCorrection parseGradientCorrection(const std::string& name);  // invalid_argument
+
 template <int D>
 struct ReferenceConfiguration {
   NeighbourList neighbours;
@@ -18,9 +29,20 @@ struct ReferenceConfiguration {
   std::vector<Vec<D>> separation;        // X_IJ = X_I - X_J (minimum image)
   std::vector<Vec<D>> weightedGradient;  // w_IJ = V_J gradW_IJ
   std::vector<double> kernelValue;       // W(X_IJ)
+  // g_IJ: grad f_I = sum_J (f_J - f_I) g_IJ, so F_I = 1 + sum_J (u_J - u_I) (x) g_IJ.
+  // Linear correction: g_IJ = L_I^{-T} w_IJ.
+  std::vector<Vec<D>> correctedGradient;
+  // Quadratic correction only: the linear g_IJ = L_I^{-T} w_IJ as well, for the hourglass
+  // penalty's smooth field F_I X_IJ (with the quadratic F the penalty turns unstable).
+  std::vector<Vec<D>> linearGradient;
+  // t_IJ = (V_J / V_I) g_JI, the reverse pair's vector, so the force -dE/du_I is
+  // V_I (P_I G_I - sum_J P_J t_IJ) with one pass over I's own list.
+  std::vector<Vec<D>> reverseGradient;
   // Per particle:
-  std::vector<Mat<D>> correctionInverse;  // L_I^{-1}, (6.44)
-  std::vector<Vec<D>> gradientSum;        // s_I = sum_J w_IJ
+  std::vector<Mat<D>> correctionInverse;     // L_I^{-1}, (6.44)
+  std::vector<Vec<D>> gradientSum;           // s_I = sum_J w_IJ
+  std::vector<Vec<D>> correctedGradientSum;  // G_I = sum_J g_IJ
+  GradientCorrection correction = GradientCorrection::Linear;
 
   Index particleCount() const { return neighbours.particleCount(); }
 };
@@ -32,6 +54,7 @@ inline constexpr double kDefaultMinCorrectionCondition = 1e-6;
 template <int D>
 ReferenceConfiguration<D> buildReferenceConfiguration(
     const std::vector<Vec<D>>& X, const std::vector<double>& volume, const Kernel<D>& kernel,
-    const PeriodicBox<D>& box = {}, double minCorrectionCondition = kDefaultMinCorrectionCondition);
+    const PeriodicBox<D>& box = {}, GradientCorrection correction = GradientCorrection::Linear,
+    double minCorrectionCondition = kDefaultMinCorrectionCondition);
 
 }  // namespace tlsph

@@ -8,6 +8,7 @@
 #include "tlsph/Kernel.hpp"
 #include "tlsph/Particles.hpp"
 #include "tlsph/PeriodicBox.hpp"
+#include "tlsph/ReferenceConfiguration.hpp"
 #include "tlsph/Types.hpp"
 
 namespace tlsph {
@@ -17,7 +18,8 @@ struct Scene {
   ParticleSet<D> particles;
   std::vector<Material> materials;
   KernelType kernel = KernelType::WendlandC2;
-  double supportRadius = 0.0;         // H = 2h
+  double supportRadius = 0.0;  // H = 2h
+  GradientCorrection gradientCorrection = GradientCorrection::Linear;
   double hourglassCoefficient = 0.0;  // alpha of (6.80); 0: no hourglass pass at all
   PeriodicBox<D> periodicBox;
   Vec<D> gravity = Vec<D>::Zero();  // body force per unit mass

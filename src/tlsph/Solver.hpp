@@ -43,7 +43,7 @@ class Solver {
       : scene_(scene),
         ref_(buildReferenceConfiguration<D>(scene.particles.referencePosition,
                                             scene.particles.volume, checkedKernel(scene),
-                                            scene.periodicBox)),
+                                            scene.periodicBox, scene.gradientCorrection)),
         forces_(ref_, scene.materials, scene.particles.material, scene.particles.volume,
                 scene.hourglassCoefficient) {
     if (!(settings.cfl > 0.0)) throw SetupError("the CFL number must be positive");

@@ -1,6 +1,9 @@
 // The per-step pair loops of total-Lagrangian SPH, read against DESIGN.md section 2:
-//   displacements u -> deformation gradients F (6.69) -> stresses P -> B = P L^{-T}
+//   displacements u -> deformation gradients F (6.69) -> stresses P
 //   -> internal force (6.70) + Ganzenmueller hourglass force (6.80, 6.81).
+// The corrected gradient vectors g_IJ (ReferenceConfiguration) carry L^{-1}: with them
+// F_I = 1 + sum_J (u_J - u_I) (x) g_IJ and f_I = -dE/du_I = V_I (P_I G_I - sum_J P_J t_IJ),
+// which for the linear correction is (6.70): V_I sum_J V_J (B_I + B_J) gradW_IJ, B = P L^{-T}.
 // Everything that depends only on the reference configuration is precomputed, so the
 // loops carry no branch on options: the hourglass term is a template parameter.
 #pragma once
@@ -28,11 +31,13 @@ class TlsphForces {
         volume_(volume),
         alpha_(hourglassCoefficient),
         F_(reference.particleCount(), Mat<D>::Identity()),
-        B_(reference.particleCount(), Mat<D>::Zero()) {
+        P_(reference.particleCount(), Mat<D>::Zero()) {
     const Index n = reference.particleCount();
     particlesOfMaterial_.resize(materials.size());
     for (Index i = 0; i < n; ++i)
       particlesOfMaterial_.at(materialOfParticle[i]).push_back(i);
+    separateHourglassGradient_ = alpha_ != 0.0 && !reference.linearGradient.empty();
+    if (separateHourglassGradient_) hourglassF_.assign(n, Mat<D>::Identity());
     if (alpha_ != 0.0) {
       // c_IJ = alpha (E_I + E_J)/2 V_J W_IJ / |X_IJ|^2: symmetric in I, J, so the pair
       // forces stay antisymmetric across material interfaces.
@@ -72,10 +77,7 @@ class TlsphForces {
   const std::vector<Vec<D>>& hourglassForce() const { return hourglassForce_; }
 
   // First Piola-Kirchhoff stress of particle i at the last computed F.
-  Mat<D> firstPiola(Index i) const {
-    return std::visit([&](const auto& model) { return firstPiolaKirchhoff<D>(model, F_[i]); },
-                      materials_[materialOfParticle_[i]]);
-  }
+  Mat<D> firstPiola(Index i) const { return P_[i]; }
 
   // E = sum_I V_I psi(F_I) at the last computed F: the discrete strain energy whose negative
   // gradient is the internal force.
@@ -101,6 +103,19 @@ class TlsphForces {
   template <class Model>
   void deformationAndStress(const Model& model, const std::vector<Index>& group,
                             const std::vector<Vec<D>>& u) {
+    if (separateHourglassGradient_) {
+      // The penalty's own (linear-corrected) deformation gradient.
+      const auto& nb = ref_.neighbours;
+      const Index count = static_cast<Index>(group.size());
+#pragma omp parallel for schedule(static)
+      for (Index p = 0; p < count; ++p) {
+        const Index i = group[p];
+        Mat<D> gradU = Mat<D>::Zero();
+        for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k)
+          gradU.noalias() += (u[nb.neighbour[k]] - u[i]) * ref_.linearGradient[k].transpose();
+        hourglassF_[i] = Mat<D>::Identity() + gradU;
+      }
+    }
     const auto& nb = ref_.neighbours;
     const Index count = static_cast<Index>(group.size());
 #pragma omp parallel for schedule(static)
@@ -109,11 +124,10 @@ class TlsphForces {
       const Vec<D> ui = u[i];
       Mat<D> gradU = Mat<D>::Zero();
       for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k)
-        gradU.noalias() += (u[nb.neighbour[k]] - ui) * ref_.weightedGradient[k].transpose();
-      const Mat<D>& Linv = ref_.correctionInverse[i];
-      const Mat<D> F = Mat<D>::Identity() + gradU * Linv;  // (6.69)
+        gradU.noalias() += (u[nb.neighbour[k]] - ui) * ref_.correctedGradient[k].transpose();
+      const Mat<D> F = Mat<D>::Identity() + gradU;  // (6.69)
       F_[i] = F;
-      B_[i].noalias() = firstPiolaKirchhoff<D>(model, F) * Linv.transpose();  // B = P L^{-T}
+      P_[i] = firstPiolaKirchhoff<D>(model, F);
     }
   }
 
@@ -123,19 +137,19 @@ class TlsphForces {
     const Index n = ref_.particleCount();
 #pragma omp parallel for schedule(static)
     for (Index i = 0; i < n; ++i) {
-      // (6.70) as a force: f_I = V_I sum_J V_J (B_I + B_J) gradW_IJ = V_I (B_I s_I + sum_J B_J
-      // w_IJ)
-      Vec<D> internal = B_[i] * ref_.gradientSum[i];
+      // (6.70) as a force: f_I = V_I (P_I G_I - sum_J P_J t_IJ)
+      Vec<D> internal = P_[i] * ref_.correctedGradientSum[i];
       Vec<D> hourglass = Vec<D>::Zero();
       const Vec<D> ui = u[i];
-      const Mat<D> Fi = F_[i];
+      const std::vector<Mat<D>>& Fh = separateHourglassGradient_ ? hourglassF_ : F_;
+      const Mat<D> Fi = Fh[i];
       for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
         const Index j = nb.neighbour[k];
-        internal.noalias() += B_[j] * ref_.weightedGradient[k];
+        internal.noalias() -= P_[j] * ref_.reverseGradient[k];
         if constexpr (Hourglass) {
           const Vec<D>& Xij = ref_.separation[k];
           const Vec<D> xij = Xij + (ui - u[j]);
-          const Vec<D> error = xij - 0.5 * ((Fi + F_[j]) * Xij);  // (6.81) before projection
+          const Vec<D> error = xij - 0.5 * ((Fi + Fh[j]) * Xij);  // (6.81) before projection
           // (6.80): -c_IJ eps_IJ x_IJ/|x_IJ| with eps_IJ = error . x_IJ/|x_IJ|
           hourglass -= (hourglassStiffness_[k] * error.dot(xij) / xij.squaredNorm()) * xij;
         }
@@ -156,7 +170,9 @@ class TlsphForces {
   double alpha_;
   std::vector<std::vector<Index>> particlesOfMaterial_;
   std::vector<Mat<D>> F_;
-  std::vector<Mat<D>> B_;
+  std::vector<Mat<D>> P_;
+  bool separateHourglassGradient_ = false;
+  std::vector<Mat<D>> hourglassF_;
   std::vector<double> hourglassStiffness_;
   std::vector<Vec<D>> hourglassForce_;
 };
