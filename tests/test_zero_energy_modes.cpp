@@ -53,11 +53,13 @@ Spectrum spectrum(const Eigen::MatrixXd& K) {
 }
 
 template <int D>
-Spectrum latticeSpectrum(int cellsPerAxis, bool periodic, double supportRatio, double alpha) {
+Spectrum latticeSpectrum(int cellsPerAxis, bool periodic, double supportRatio, double alpha,
+                         GradientCorrection correction = GradientCorrection::Linear) {
   std::array<int, D> counts;
   counts.fill(cellsPerAxis);
   auto scene = sceneOf<D>(cellCentredLattice<D>(Vec<D>::Zero(), counts, kDx), kDx, supportRatio,
                           testMaterial("linear-elastic"), alpha);
+  scene.gradientCorrection = correction;
   if (periodic) {
     scene.periodicBox.periodic.fill(true);
     scene.periodicBox.length = Vec<D>::Constant(cellsPerAxis * kDx);
@@ -94,4 +96,16 @@ TEST(ZeroEnergyModes, PenaltyStiffensTheLowEnergyModesOfAFreeBlock) {
             << without.lowestNonZero << " without penalty, " << with.lowestNonZero
             << " with alpha = 10\n";
   EXPECT_GT(with.lowestNonZero / without.lowestNonZero, 10.0);
+}
+
+// The quadratic correction changes the stress's F, not the penalty's: with the penalty on, the
+// periodic lattice keeps only the translations and a free block only its rigid-body modes.
+TEST(ZeroEnergyModes, QuadraticCorrectionWithPenaltyHasOnlyPhysicalZeros) {
+  const auto q = GradientCorrection::Quadratic;
+  EXPECT_EQ(latticeSpectrum<2>(8, true, 2.1, 10.0, q).zeros, 2);
+  EXPECT_EQ(latticeSpectrum<3>(5, true, 2.1, 10.0, q).zeros, 3);
+  EXPECT_EQ(latticeSpectrum<2>(8, false, 2.5, 10.0, q).zeros, 3);
+  EXPECT_EQ(latticeSpectrum<3>(4, false, 2.5, 10.0, q).zeros, 6);
+  std::cout << "quadratic, periodic 8x8, support 2.1 dx, no penalty: "
+            << latticeSpectrum<2>(8, true, 2.1, 0.0, q).zeros << " zero modes\n";
 }
