@@ -31,6 +31,7 @@
 #include <string>
 #include <vector>
 
+#include "ProgramRunner.hpp"
 #include "compare/Comparison.hpp"
 #include "compare/ComparisonFrame.hpp"
 #include "compare/ComparisonReport.hpp"
@@ -44,6 +45,7 @@
 
 using namespace tlsph;
 namespace fs = std::filesystem;
+using tlsph::testing::runProgram;
 
 namespace {
 
@@ -627,20 +629,6 @@ TEST_F(CompareTest, FramesAreFoundFromTheRunDirectory) {
 
 namespace {
 
-struct Result {
-  int status = -1;
-  std::string output;
-};
-
-Result runProgram(const std::string& arguments, const fs::path& log) {
-  const std::string command =
-      std::string(TLSPH_PROGRAM) + " " + arguments + " > " + log.string() + " 2>&1";
-  Result r;
-  r.status = WEXITSTATUS(std::system(command.c_str()));
-  r.output = readText(log);
-  return r;
-}
-
 // The number after "key": inside the JSON object of `field`.
 double jsonValue(const std::string& json, const std::string& field, const std::string& key) {
   const auto start = json.find("\"" + field + "\": {");
@@ -658,10 +646,11 @@ double jsonValue(const std::string& json, const std::string& field, const std::s
 TEST_F(CompareTest, EndToEndAgainstTheRunAsAnFemMesh) {
   // The clamped plate (40 x 40 x 4 particles, dx = 12.5 mm), static.
   const fs::path out = dir_ / "plate";
-  Result r = runProgram("run " + std::string(TLSPH_SOURCE_DIR) +
-                            "/examples/clamped_plate.ini --output.directory=" + out.string() +
-                            " \"--output.fields=displacement cauchy_stress flags\"",
-                        dir_ / "run.log");
+  tlsph::testing::ProgramResult r =
+      runProgram("run " + std::string(TLSPH_SOURCE_DIR) +
+                     "/examples/clamped_plate.ini --output.directory=" + out.string() +
+                     " \"--output.fields=displacement cauchy_stress flags\"",
+                 dir_ / "run.log");
   ASSERT_EQ(r.status, 0) << r.output;
 
   // An "FEM" hexahedral mesh whose nodes are the body particles' reference positions, carrying

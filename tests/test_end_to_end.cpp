@@ -13,30 +13,16 @@
 #include <fstream>
 #include <map>
 #include <regex>
+
 #include <sstream>
 #include <string>
 #include <vector>
+#include "ProgramRunner.hpp"
 
 namespace fs = std::filesystem;
+using tlsph::testing::runProgram;
 
 namespace {
-
-struct Result {
-  int status = -1;
-  std::string output;
-};
-
-Result runProgram(const std::string& arguments, const fs::path& log) {
-  const std::string command =
-      std::string(TLSPH_PROGRAM) + " " + arguments + " > " + log.string() + " 2>&1";
-  Result r;
-  r.status = WEXITSTATUS(std::system(command.c_str()));
-  std::ifstream in(log);
-  std::stringstream text;
-  text << in.rdbuf();
-  r.output = text.str();
-  return r;
-}
 
 // Last data row of a CSV file with '#' preamble lines, as name -> value.
 std::map<std::string, double> lastRow(const fs::path& csv) {
@@ -73,10 +59,10 @@ class EndToEnd : public ::testing::Test {
 }  // namespace
 
 TEST_F(EndToEnd, CantileverConvergesOnTimoshenkoDeflection) {
-  const Result r = runProgram("run " + std::string(TLSPH_SOURCE_DIR) +
-                                  "/examples/cantilever.ini --output.directory=" + dir_.string() +
-                                  " --output.every_time=1",
-                              dir_ / "log.txt");
+  const auto r = runProgram("run " + std::string(TLSPH_SOURCE_DIR) +
+                                "/examples/cantilever.ini --output.directory=" + dir_.string() +
+                                " --output.every_time=1",
+                            dir_ / "log.txt");
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("converged"), std::string::npos) << r.output;
   const auto row = lastRow(dir_ / "probes.csv");
@@ -119,18 +105,18 @@ TEST_F(EndToEnd, CantileverConvergesOnTimoshenkoDeflection) {
 }
 
 TEST_F(EndToEnd, BadInputExitsNonZeroAndWritesNothing) {
-  const Result r = runProgram("run " + std::string(TLSPH_SOURCE_DIR) +
-                                  "/examples/cantilever.ini --material.rubber.poisson_ratio=0.7 "
-                                  "--output.directory=" +
-                                  (dir_ / "out").string(),
-                              dir_ / "log.txt");
+  const auto r = runProgram("run " + std::string(TLSPH_SOURCE_DIR) +
+                                "/examples/cantilever.ini --material.rubber.poisson_ratio=0.7 "
+                                "--output.directory=" +
+                                (dir_ / "out").string(),
+                            dir_ / "log.txt");
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.output.find("[material.rubber]"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(dir_ / "out"));
 }
 
 TEST_F(EndToEnd, CheckPrintsTheSetUpWithoutRunning) {
-  const Result r = runProgram(
+  const auto r = runProgram(
       "check " + std::string(TLSPH_SOURCE_DIR) +
           "/examples/oscillating_plate.ini --output.directory=" + (dir_ / "out").string(),
       dir_ / "log.txt");
