@@ -5,6 +5,8 @@
 #   scripts/setup.sh build     install + build (default)
 #   scripts/setup.sh test      install + build + run the test suite (ctest)
 #   scripts/setup.sh example   install + build + run the main example scene
+#   scripts/setup.sh validate  install (+ numpy, matplotlib) + build + run the full validation
+#                              ladder (validation/run.py, ~30 min on 2 cores): validation/report/
 #
 # Environment: BUILD_DIR (default build), JOBS (default: number of cores).
 set -euo pipefail
@@ -15,7 +17,11 @@ build_dir="${BUILD_DIR:-build}"
 jobs="${JOBS:-$(nproc)}"
 
 packages=(cmake make g++ libeigen3-dev libboost-program-options-dev libvtk9-dev
-  libgtest-dev googletest)
+  libgtest-dev googletest python3)
+# The validation report's plots need numpy and matplotlib (the quick check under ctest does not).
+if [ "$action" = validate ]; then
+  packages+=(python3-numpy python3-matplotlib)
+fi
 
 missing=()
 for pkg in "${packages[@]}"; do
@@ -44,8 +50,14 @@ case "$action" in
     "$build_dir/tlsph" run examples/cantilever.ini --output.directory=output/cantilever
     echo "setup: open $(pwd)/output/cantilever/cantilever.pvd in ParaView"
     ;;
+  validate)
+    # Every reference problem at its resolution ladder plus the sensitivity studies; writes
+    # validation/report/ (README.md, results.json, plots). Extra arguments go to the runner.
+    shift || true
+    /usr/bin/python3 validation/run.py --build-dir "$build_dir" "$@"
+    ;;
   *)
-    echo "usage: scripts/setup.sh [build|test|example]" >&2
+    echo "usage: scripts/setup.sh [build|test|example|validate]" >&2
     exit 2
     ;;
 esac

@@ -418,7 +418,7 @@ class Builder {
     d.finish();
     SectionReader s(config_, "static");
     setup_.run.quasiStatic = s.flag("enabled", config_.hasSection("static"));
-    setup_.run.tolerance = s.positive("tolerance", 1e-4);
+    setup_.run.tolerance = s.positive("tolerance", 1e-5);
     setup_.run.checkEvery = std::max(1L, s.integer("check_every", 50));
     s.finish();
     SectionReader t(config_, "time");

@@ -1,0 +1,902 @@
+#!/usr/bin/env python3
+"""tlsph validation: error against run time, for the reference problems of DESIGN.md section 6.
+
+From the repository root (the build must exist: `bash scripts/setup.sh build`):
+
+  /usr/bin/python3 validation/run.py                  # full ladder + sensitivities (~30 min on
+                                                      # 2 cores); writes validation/report/
+  /usr/bin/python3 validation/run.py --quick --check  # one coarse run per problem (< 1 min),
+                                                      # errors checked against tolerances.json
+  /usr/bin/python3 validation/run.py --report-only    # README.md and plots from results.json
+  /usr/bin/python3 validation/run.py --derive-tolerances   # tolerances.json from results.json
+  /usr/bin/python3 validation/run.py --plan           # list the runs, run nothing
+
+`bash scripts/setup.sh validate` installs what is missing, builds and runs the full ladder.
+
+Each run is `build/tlsph run validation/scenes/<problem>.ini --output.directory=<runs>/<id>
+--output.fields=none --no-progress [overrides]` with OMP_NUM_THREADS = --threads (default: all
+cores), one after the other. The runner reads the run's summary.json and probes.csv, extracts
+the quantity of interest, and compares it with the reference (validation/references.py). Every
+run's record (particles, neighbours, steps, dt, wall time, threads, git commit, the command
+that reproduces it, outcome, quantities, errors) goes to validation/report/results.json;
+validation/report/README.md and the PNG plots are made from that file (numpy and matplotlib
+are needed for the plots only). Exit status 4 (unstable) or 3 (static run not converged) is a
+result to report, not a failure of the runner.
+
+Running, parsing and checking use the Python standard library only (CI has no numpy).
+"""
+
+import argparse
+import json
+import math
+import os
+import platform
+import shlex
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent
+sys.path.insert(0, str(HERE))
+
+import references as refs  # noqa: E402
+
+# --------------------------------------------------------------------------------------------
+# References
+
+
+def compute_references():
+    """Reference numbers (DESIGN.md section 6 and the sources cited in the scene files)."""
+    r = {}
+    # Oscillating plate (Gray, Monaghan & Swift 2001), plane strain.
+    E, nu, rho, H, L = 2.0e6, 0.3975, 1000.0, 0.02, 0.2
+    K = E / (3.0 * (1.0 - 2.0 * nu))
+    T_thin = refs.thin_plate_period(E, nu, rho, H, L)
+    f_timo = refs.timoshenko_frequency(E / (1 - nu**2), nu, rho, H, H**3 / 12.0, L,
+                                       G=E / (2 * (1 + nu)))
+    r["oscillating_plate"] = {
+        "period": T_thin,
+        "period_timoshenko": 1.0 / f_timo,
+        "c0": math.sqrt(K / rho),
+        "omega": 2 * math.pi / T_thin,
+        "source": "thin-plate theory as in Gray, Monaghan & Swift (2001): omega^2 = E H^2 k^4 / "
+                  "(12 rho0 (1 - nu^2)), k = 1.875/L",
+    }
+    # Cantilever, 3D.
+    E, nu, rho, b, L = 1.0e7, 0.3, 1000.0, 0.1, 1.0
+    A, I = b * b, b**4 / 12.0
+    q = rho * 1.0 * A
+    r["cantilever"] = {
+        "tip_timoshenko": 0.01516,
+        "tip_timoshenko_computed": refs.timoshenko_static_tip(q, E, nu, A, I, L),
+        "tip_euler_bernoulli": q * L**4 / (8 * E * I),
+        "tip_fem": 0.01501,
+        "f_euler_bernoulli": refs.euler_bernoulli_frequency(E, I, rho, A, L),
+        "f_timoshenko": refs.timoshenko_frequency(E, nu, rho, A, I, L),
+        "f_timoshenko_no_rotary": refs.timoshenko_frequency(E, nu, rho, A, I, L,
+                                                            rotary_inertia=False),
+        "kappa": refs.rectangle_shear_coefficient(nu),
+    }
+    # Turek & Hron (2006) CSM1, CSM3.
+    r["csm1"] = {"ux": -7.187e-3, "uy": -6.610e-2}
+    r["csm3"] = {"ux_mean": -1.4305e-2, "ux_amp": 1.4305e-2, "uy_mean": -6.3607e-2,
+                 "uy_amp": 6.5541e-2, "frequency": 1.0995}
+    # Clamped square plate.
+    E, nu, t, a, qp = 1.0e7, 0.3, 0.05, 0.5, 1000.0
+    r["clamped_plate"] = {
+        "w_kirchhoff": refs.kirchhoff_plate_deflection(E, nu, t, a, qp),
+        "kirchhoff_coefficient_ritz": refs.kirchhoff_clamped_square(nu, n=6),
+        "w_mindlin": refs.mindlin_clamped_square(E, nu, t, a, qp, n=6),
+    }
+    return r
+
+
+# --------------------------------------------------------------------------------------------
+# Reading a run
+
+
+def read_series(path):
+    """A tlsph CSV series: '#' preamble lines, a header row, numbers. Returns {column: list}."""
+    header, rows = None, []
+    with open(path) as f:
+        for line in f:
+            line = line.strip()
+            if not line or line.startswith("#"):
+                continue
+            if header is None:
+                header = line.split(",")
+                continue
+            rows.append([float(x) for x in line.split(",")])
+    if header is None:
+        return {}
+    return {h: [r[i] for r in rows] for i, h in enumerate(header)}
+
+
+def finite(values):
+    return all(math.isfinite(v) for v in values)
+
+
+def crossings(t, u, level, band, t_min=0.0):
+    """Times where u crosses `level` (linear interpolation between samples), with hysteresis:
+    a crossing counts only once u has gone beyond level +- band on the other side, so ripples
+    of higher modes near a crossing are not counted twice."""
+    out = []
+    state = 0
+    last_cross = None
+    for i in range(1, len(t)):
+        if t[i] < t_min:
+            continue
+        a, b = u[i - 1] - level, u[i] - level
+        if t[i - 1] >= t_min and a != b and ((a < 0) != (b < 0)) and a != 0.0:
+            last_cross = t[i - 1] + (t[i] - t[i - 1]) * a / (a - b)
+        s = 1 if b > band else (-1 if b < -band else 0)
+        if s != 0:
+            if state != 0 and s != state and last_cross is not None:
+                out.append(last_cross)
+            state = s
+    return out
+
+
+def extrema_between(t, u, level, cross):
+    """Time and value of the extremum of u - level between successive crossings, refined by
+    a parabola through the largest sample and its neighbours."""
+    out = []
+    for c0, c1 in zip(cross, cross[1:]):
+        idx = [i for i in range(len(t)) if c0 < t[i] < c1]
+        if len(idx) < 3:
+            continue
+        k = max(idx, key=lambda i: abs(u[i] - level))
+        if k - 1 < 0 or k + 1 >= len(t):
+            continue
+        u0, u1, u2 = u[k - 1], u[k], u[k + 1]
+        h = 0.5 * (t[k + 1] - t[k - 1])
+        den = u0 - 2 * u1 + u2
+        s = 0.5 * (u0 - u2) / den if den != 0 else 0.0
+        s = max(-1.0, min(1.0, s))
+        out.append((t[k] + s * h, u1 - 0.25 * (u0 - u2) * s))
+    return out
+
+
+def period_from_crossings(cross):
+    if len(cross) < 2:
+        return None
+    return 2.0 * (cross[-1] - cross[0]) / (len(cross) - 1)
+
+
+def energy_drift(energies):
+    """(total(end) - total(0)) / E_scale in %, E_scale the largest kinetic + strain + |hourglass|
+    or |external work| over the first fifth of the run (before any blow-up)."""
+    tot = energies.get("total")
+    if not tot:
+        return None
+    n = max(2, len(tot) // 5)
+    scale = max(max(k + s + abs(h), abs(w)) for k, s, h, w in
+                zip(energies["kinetic"][:n], energies["strain"][:n], energies["hourglass"][:n],
+                    energies["external_work"][:n]))
+    if scale <= 0 or not finite([tot[0], tot[-1]]):
+        return None
+    return 100.0 * (tot[-1] - tot[0]) / scale
+
+
+ENERGY_GROWTH_PCT = 1.0  # a run whose energy books drift by more is flagged "energy-growth"
+
+
+def pct(value, reference):
+    if value is None or reference is None or not math.isfinite(value):
+        return None
+    return 100.0 * (value - reference) / abs(reference)
+
+
+# --------------------------------------------------------------------------------------------
+# Quantities of interest. Each extractor returns {"values": {...}, "errors": {...} (signed %),
+# "primary": name of the error that is the problem's headline, "notes": [...]}.
+
+
+def extract_oscillating_plate(series, summary, R):
+    ref = R["oscillating_plate"]
+    t, uy, vy = series["time"], series["tip_uy"], series["tip_vy"]
+    amp = max(abs(v) for v in uy)
+    cu = crossings(t, uy, 0.0, 0.05 * amp, t_min=1e-12)
+    vamp = max(abs(v) for v in vy)
+    cv = crossings(t, vy, 0.0, 0.05 * vamp, t_min=1e-12)
+    T_u, T_v = period_from_crossings(cu), period_from_crossings(cv)
+    values = {"period": T_u, "period_from_velocity": T_v, "crossings": len(cu),
+              "periods_measured": (cu[-1] - cu[0]) / T_u if T_u else None,
+              "tip_amplitude": amp}
+    return {"values": values,
+            "errors": {"period": pct(T_u, ref["period"]),
+                       "period_vs_timoshenko": pct(T_u, ref["period_timoshenko"]),
+                       "period_from_velocity": pct(T_v, ref["period"])},
+            "primary": "period"}
+
+
+def extract_cantilever_static(series, summary, R):
+    ref = R["cantilever"]
+    w = -series["tip_uz"][-1]
+    w95, w90 = -series["x095_uz"][-1], -series["x090_uz"][-1]
+    w_ex = 2 * w95 - w90
+    return {"values": {"tip": w, "tip_extrapolated": w_ex, "tip_ux": series["tip_ux"][-1]},
+            "errors": {"tip": pct(w, ref["tip_timoshenko"]),
+                       "tip_vs_fem": pct(w, ref["tip_fem"]),
+                       "tip_extrapolated": pct(w_ex, ref["tip_timoshenko"])},
+            "primary": "tip"}
+
+
+def extract_cantilever_dynamic(series, summary, R):
+    ref = R["cantilever"]
+    t, uz = series["time"], series["tip_uz"]
+    hi, lo = max(uz), min(uz)
+    mean, amp = 0.5 * (hi + lo), 0.5 * (hi - lo)
+    cr = crossings(t, uz, mean, 0.05 * amp, t_min=1e-12)
+    T = period_from_crossings(cr)
+    f = 1.0 / T if T else None
+    return {"values": {"frequency": f, "crossings": len(cr),
+                       "periods_measured": (cr[-1] - cr[0]) / T if T else None,
+                       "mean_deflection": -mean, "amplitude": amp},
+            "errors": {"frequency": pct(f, ref["f_timoshenko"]),
+                       "frequency_vs_euler_bernoulli": pct(f, ref["f_euler_bernoulli"]),
+                       "mean_deflection": pct(-mean, ref["tip_timoshenko"])},
+            "primary": "frequency"}
+
+
+def extract_csm1(series, summary, R):
+    ref = R["csm1"]
+    ux, uy = series["A_ux"][-1], series["A_uy"][-1]
+    ex_x = 2 * series["x033_ux"][-1] - series["x031_ux"][-1]
+    ex_y = 2 * series["x033_uy"][-1] - series["x031_uy"][-1]
+    norm_ref = math.hypot(ref["ux"], ref["uy"])
+
+    def vec_err(x, y):
+        return 100.0 * math.hypot(x - ref["ux"], y - ref["uy"]) / norm_ref
+
+    return {"values": {"ux": ux, "uy": uy, "ux_extrapolated": ex_x, "uy_extrapolated": ex_y},
+            "errors": {"displacement": vec_err(ux, uy), "ux": pct(ux, ref["ux"]),
+                       "uy": pct(uy, ref["uy"]),
+                       "displacement_extrapolated": vec_err(ex_x, ex_y),
+                       "ux_extrapolated": pct(ex_x, ref["ux"]),
+                       "uy_extrapolated": pct(ex_y, ref["uy"])},
+            "primary": "displacement"}
+
+
+CSM3_WINDOW_START = 1.0 / 1.0995  # one reference period
+
+
+def csm3_signal(t, u):
+    """Mean, amplitude, and frequency (from successive extrema) of u over t >= one period."""
+    idx = [i for i in range(len(t)) if t[i] >= CSM3_WINDOW_START]
+    if len(idx) < 10:
+        return None
+    tw, uw = [t[i] for i in idx], [u[i] for i in idx]
+    hi, lo = max(uw), min(uw)
+    mean, amp = 0.5 * (hi + lo), 0.5 * (hi - lo)
+    cr = crossings(tw, uw, mean, 0.05 * amp)
+    ext = extrema_between(tw, uw, mean, cr)
+    f = None
+    if len(ext) >= 2:
+        f = (len(ext) - 1) / (2.0 * (ext[-1][0] - ext[0][0]))
+    Tc = period_from_crossings(cr)
+    return {"mean": mean, "amp": amp, "frequency": f,
+            "frequency_from_crossings": 1.0 / Tc if Tc else None, "extrema": len(ext),
+            "window": [tw[0], tw[-1]]}
+
+
+def extract_csm3(series, summary, R):
+    ref = R["csm3"]
+    t = series["time"]
+    sx = csm3_signal(t, series["A_ux"])
+    sy = csm3_signal(t, series["A_uy"])
+    ex_y = [2 * a - b for a, b in zip(series["x033_uy"], series["x031_uy"])]
+    ex_x = [2 * a - b for a, b in zip(series["x033_ux"], series["x031_ux"])]
+    sey, sex = csm3_signal(t, ex_y), csm3_signal(t, ex_x)
+    v = {"frequency": sy["frequency"], "frequency_from_crossings": sy["frequency_from_crossings"],
+         "extrema": sy["extrema"], "window": sy["window"],
+         "ux_mean": sx["mean"], "ux_amp": sx["amp"], "uy_mean": sy["mean"], "uy_amp": sy["amp"],
+         "uy_mean_extrapolated": sey["mean"], "uy_amp_extrapolated": sey["amp"],
+         "ux_mean_extrapolated": sex["mean"], "ux_amp_extrapolated": sex["amp"]}
+    e = {"frequency": pct(v["frequency"], ref["frequency"]),
+         "frequency_from_crossings": pct(v["frequency_from_crossings"], ref["frequency"])}
+    for k in ("ux_mean", "ux_amp", "uy_mean", "uy_amp"):
+        e[k] = pct(v[k], ref[k])
+        e[k + "_extrapolated"] = pct(v[k + "_extrapolated"], ref[k])
+    return {"values": v, "errors": e, "primary": "frequency"}
+
+
+def extract_clamped_plate(series, summary, R):
+    ref = R["clamped_plate"]
+    w = -series["centre_uz"][-1]
+    return {"values": {"w": w},
+            "errors": {"w": pct(w, ref["w_kirchhoff"]), "w_vs_mindlin": pct(w, ref["w_mindlin"])},
+            "primary": "w"}
+
+
+# --------------------------------------------------------------------------------------------
+# Problems
+
+
+class Problem:
+    def __init__(self, key, title, scene, dim, thickness, ladder, quick_dx, sens_dx, extract,
+                 static, qoi, unit, target=None, variants=None, sensitivity=None,
+                 checked=None, cross=None, quick_variant=0, sens_variant=0,
+                 variant_ladders=None):
+        self.key, self.title, self.scene, self.dim = key, title, scene, dim
+        self.thickness, self.ladder = thickness, ladder
+        self.quick_dx, self.sens_dx = quick_dx, sens_dx
+        self.extract, self.static, self.qoi, self.unit = extract, static, qoi, unit
+        self.target = target  # (error name, |error| % at the finest resolution)
+        self.variants = variants or [("", {})]
+        self.sensitivity = sensitivity or {}
+        self.checked = checked or []  # error names the quick check compares
+        self.cross = cross or []  # combined settings, e.g. {alpha, cfl}: does the dt rule hold?
+        self.quick_variant = quick_variant  # the variant the quick check runs
+        self.sens_variant = sens_variant  # the variant the sensitivity studies start from
+        self.variant_ladders = variant_ladders or {}  # variant -> its own (shorter) ladder
+
+
+# Sensitivity values; the defaults (support 2.1, quadratic correction, alpha 10, CFL 0.3, the
+# scenes' static tolerance 1e-5) are the ladder run at the same resolution. The CFL values
+# bracket the limit of the quadratic correction (0.4 in 3D, 0.5 in 2D by the lead's
+# measurements). Cut to keep the full ladder near 30 minutes on 2 cores: alpha 100 where a
+# run costs more than a few seconds (a stiff penalty slows kinetic damping ten-fold).
+SUPPORT = [2.0, 2.5, 3.0]
+ALPHA = [0.0, 1.0, 50.0, 100.0]
+CFL = [0.4, 0.5, 0.6]
+TOL = [1e-4, 1e-6]
+LINEAR = ["linear"]
+
+# Does the time-step rule hold with a stiff hourglass penalty? If alpha = 50 or 100 fails at
+# the default CFL, does a step three times smaller cure it (a time-step limit) or not (an
+# instability of the semi-discrete equations)? For the oscillating plate (dynamic, cheap).
+CROSS = [{"hourglass.alpha": a, "time.cfl": 0.1} for a in (50.0, 100.0)]
+
+PROBLEMS = [
+    Problem("oscillating_plate", "Oscillating plate (Gray, Monaghan & Swift 2001), 2D",
+            "oscillating_plate.ini", 2, 0.02, [0.005, 0.0025, 0.00125], 0.005, 0.0025,
+            extract_oscillating_plate, False, "period", "s", target=("period", 3.0),
+            variants=[("Vf0.01", {}), ("Vf0.001", {"initial.mode.amplitude_over_c0": "0.001"})],
+            sensitivity={"kernel.support": SUPPORT, "kernel.correction": LINEAR,
+                         "hourglass.alpha": ALPHA, "time.cfl": CFL},
+            checked=["period"], cross=CROSS),
+    Problem("cantilever_static", "Cantilever under self-weight, static, 3D",
+            "cantilever_static.ini", 3, 0.1, [0.025, 0.0125, 0.01, 0.1 / 12], 0.025,
+            0.0125, extract_cantilever_static, True, "tip deflection", "m",
+            target=("tip", 1.0),
+            sensitivity={"kernel.support": SUPPORT, "kernel.correction": LINEAR,
+                         "hourglass.alpha": [0.0, 1.0, 50.0], "time.cfl": CFL,
+                         "static.tolerance": TOL},
+            checked=["tip", "tip_extrapolated"]),
+    Problem("cantilever_dynamic", "Cantilever, gravity applied suddenly, 3D",
+            "cantilever_dynamic.ini", 3, 0.1, [0.025, 0.0125, 0.01], 0.025, 0.0125,
+            extract_cantilever_dynamic, False, "first bending frequency", "Hz",
+            # The defaults (alpha 10) go unstable in this undamped 3D run (at every CFL: an
+            # instability of the equations, not of the step); the alpha = 1 ladder measures
+            # the frequency, and the sensitivities start from it.
+            variants=[("", {}), ("alpha1", {"hourglass.alpha": "1"})], quick_variant=1,
+            sens_variant=1, variant_ladders={"": [0.025, 0.0125]},
+            sensitivity={"hourglass.alpha": [3.0], "kernel.correction": LINEAR,
+                         "time.cfl": [0.4]},
+            checked=["frequency"]),
+    Problem("csm1", "Turek & Hron CSM1, static, 2D", "turek_hron_csm1.ini", 2, 0.02,
+            [0.005, 0.0025, 0.00125], 0.005, 0.0025, extract_csm1, True,
+            "tip displacement (point A)", "m", target=("displacement", 2.0),
+            sensitivity={"kernel.support": SUPPORT, "kernel.correction": LINEAR,
+                         "hourglass.alpha": [0.0, 1.0, 50.0], "time.cfl": CFL,
+                         "static.tolerance": TOL},
+            checked=["displacement", "ux", "uy"]),
+    Problem("csm3", "Turek & Hron CSM3, dynamic, 2D", "turek_hron_csm3.ini", 2, 0.02,
+            [0.005, 0.0025, 0.00125], 0.005, 0.0025, extract_csm3, False,
+            "frequency", "Hz", target=("frequency", 2.0),
+            sensitivity={"kernel.support": [2.5, 3.0], "kernel.correction": LINEAR,
+                         "hourglass.alpha": [0.0, 50.0], "time.cfl": [0.4]},
+            checked=["frequency", "uy_mean", "uy_amp", "ux_mean", "ux_amp"]),
+    Problem("clamped_plate", "Clamped square plate under pressure, static, 3D",
+            "clamped_plate.ini", 3, 0.05, [0.0125, 0.05 / 6, 0.00625], 0.0125, 0.05 / 6,
+            extract_clamped_plate, True, "centre deflection", "m",
+            sensitivity={"kernel.support": SUPPORT, "kernel.correction": LINEAR,
+                         "hourglass.alpha": ALPHA, "time.cfl": CFL, "static.tolerance": TOL},
+            checked=["w"]),
+]
+BY_KEY = {p.key: p for p in PROBLEMS}
+DEFAULTS = {"kernel.support": 2.1, "kernel.correction": "quadratic", "hourglass.alpha": 10.0,
+            "time.cfl": 0.3, "static.tolerance": 1e-5}
+SHORT = {"kernel.support": "H", "kernel.correction": "", "hourglass.alpha": "alpha",
+         "time.cfl": "cfl", "static.tolerance": "tol"}
+
+
+def fmt(x):
+    """Shortest round-trip text of a number ('0.0125', '0.008333333333333333', '10')."""
+    if isinstance(x, str):
+        return x
+    if float(x) == int(x) and abs(x) < 1e6:
+        return str(int(x))
+    return repr(float(x))
+
+
+def per_thickness(problem, dx):
+    return int(round(problem.thickness / dx))
+
+
+def run_id(problem, variant, dx, param=None, value=None):
+    parts = [problem.key]
+    if variant:
+        parts.append(variant)
+    parts.append("n%d" % per_thickness(problem, dx))
+    if isinstance(value, dict):
+        parts += ["%s%s" % (SHORT[k], fmt(v)) for k, v in value.items()]
+    elif param:
+        parts.append("%s%s" % (SHORT[param], fmt(value)))
+    return "-".join(parts)
+
+
+def plan_runs(quick, sensitivity, only):
+    """The runs to do, in order: ladders (coarse to fine), then sensitivities."""
+    runs = []
+    for p in PROBLEMS:
+        if only and p.key not in only:
+            continue
+        if quick:
+            name, ov = p.variants[p.quick_variant]
+            runs.append(dict(problem=p.key, variant=name, dx=p.quick_dx, kind="ladder",
+                             param=None, value=None, overrides=dict(ov)))
+            continue
+        for name, ov in p.variants:
+            for dx in p.variant_ladders.get(name, p.ladder):
+                runs.append(dict(problem=p.key, variant=name, dx=dx, kind="ladder", param=None,
+                                 value=None, overrides=dict(ov)))
+    if not quick and sensitivity:
+        for p in PROBLEMS:
+            if only and p.key not in only:
+                continue
+            name, ov = p.variants[p.sens_variant]
+            for param, values in p.sensitivity.items():
+                for v in values:
+                    o = dict(ov)
+                    o[param] = "%g" % v if param == "static.tolerance" else fmt(v)
+                    runs.append(dict(problem=p.key, variant=name, dx=p.sens_dx,
+                                     kind="sensitivity", param=param, value=v, overrides=o))
+            for combo in p.cross:
+                o = dict(ov)
+                o.update({k: fmt(v) for k, v in combo.items()})
+                runs.append(dict(problem=p.key, variant=name, dx=p.sens_dx, kind="cross",
+                                 param="+".join(combo), value=dict(combo), overrides=o))
+    for r in runs:
+        p = BY_KEY[r["problem"]]
+        r["id"] = run_id(p, r["variant"], r["dx"], r["param"], r["value"])
+    return runs
+
+
+# --------------------------------------------------------------------------------------------
+# Running
+
+
+def rel(path):
+    try:
+        return str(Path(path).resolve().relative_to(ROOT))
+    except ValueError:
+        return str(path)
+
+
+def git_state():
+    env = dict(os.environ, GIT_OPTIONAL_LOCKS="0")  # read-only: never refresh the index
+
+    def git(*args):
+        try:
+            return subprocess.run(["git", "-C", str(ROOT), "--no-optional-locks", *args],
+                                  capture_output=True, text=True, env=env,
+                                  timeout=60).stdout.rstrip("\n")
+        except (OSError, subprocess.SubprocessError):
+            return ""
+
+    head = git("rev-parse", "HEAD").strip() or "unknown"
+    changed = [line for line in git("status", "--porcelain").splitlines()
+               if line.strip() and not any(s in line[3:] for s in
+                                           ("validation/runs", "validation/report"))]
+    return {"commit": head + ("-dirty" if changed else ""), "changed": changed}
+
+
+def machine_info(threads, build_dir):
+    cpu = ""
+    try:
+        for line in open("/proc/cpuinfo"):
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    version = ""
+    try:
+        version = subprocess.run([str(Path(build_dir) / "tlsph"), "--version"],
+                                 capture_output=True, text=True, timeout=30).stdout.strip()
+    except (OSError, subprocess.SubprocessError):
+        pass
+    build_type = ""
+    try:
+        for line in open(Path(build_dir) / "CMakeCache.txt"):
+            if line.startswith("CMAKE_BUILD_TYPE:"):
+                build_type = line.split("=", 1)[1].strip()
+    except OSError:
+        pass
+    return {"cpu": cpu, "cores": os.cpu_count(), "threads": threads,
+            "platform": platform.platform(), "python": platform.python_version(),
+            "tlsph_version": version, "build_dir": rel(build_dir), "build_type": build_type}
+
+
+def build_command(problem, run, build_dir, runs_dir):
+    scene = ROOT / "validation" / "scenes" / problem.scene
+    outdir = Path(runs_dir) / run["id"]
+    argv = [str(Path(build_dir) / "tlsph"), "run", str(scene),
+            "--output.directory=" + str(outdir), "--output.fields=none", "--no-progress",
+            "--scene.dx=" + fmt(run["dx"])]
+    for k, v in run["overrides"].items():
+        argv.append("--%s=%s" % (k, v))
+    env = ["OMP_NUM_THREADS=%d" % run["threads"]]
+    if run.get("wait_policy"):
+        env.append("OMP_WAIT_POLICY=" + run["wait_policy"])
+    shown = env + [rel(argv[0])] + argv[1:2] + [rel(scene)]
+    shown += ["--output.directory=" + rel(outdir)] + argv[4:]
+    return argv, outdir, " ".join(shlex.quote(a) for a in shown)
+
+
+def execute(problem, run, build_dir, runs_dir, R, git, reuse, timeout):
+    argv, outdir, shown = build_command(problem, run, build_dir, runs_dir)
+    rec = dict(run)
+    rec.update(command=shown, git=git["commit"],
+               per_thickness=per_thickness(problem, run["dx"]))
+    sidecar = outdir / "runner.json"
+    reused = False
+    if reuse and sidecar.exists():
+        try:
+            old = json.loads(sidecar.read_text())
+            scene_changed = (ROOT / "validation" / "scenes" / problem.scene).stat().st_mtime
+            if (old.get("argv") == argv and old.get("rc") in (0, 3, 4) and
+                    sidecar.stat().st_mtime > scene_changed):
+                rec.update(rc=old["rc"], wall_runner=old["wall_runner"],
+                           loadavg=old.get("loadavg"), git=old.get("git", git["commit"]))
+                reused = True
+        except (OSError, ValueError):
+            pass
+    if not reused:
+        outdir.mkdir(parents=True, exist_ok=True)
+        for name in ("summary.json", "probes.csv", "energies.csv"):
+            (outdir / name).unlink(missing_ok=True)
+        env = dict(os.environ, OMP_NUM_THREADS=str(run["threads"]))
+        if run.get("wait_policy"):
+            env["OMP_WAIT_POLICY"] = run["wait_policy"]
+        env.pop("CI", None)
+        load0 = os.getloadavg()[0]
+        t0 = time.monotonic()
+        try:
+            proc = subprocess.run(argv, cwd=ROOT, env=env, capture_output=True, text=True,
+                                  timeout=timeout)
+            rc, err = proc.returncode, (proc.stderr or "")[-2000:]
+        except subprocess.TimeoutExpired:
+            rc, err = "timeout", "killed after %s s" % timeout
+        wall = time.monotonic() - t0
+        rec.update(rc=rc, wall_runner=wall, loadavg=[load0, os.getloadavg()[0]])
+        if rc not in (0, 3, 4):
+            rec["stderr"] = err
+        sidecar.write_text(json.dumps({"argv": argv, "rc": rc, "wall_runner": wall,
+                                       "loadavg": rec["loadavg"], "git": git["commit"]},
+                                      indent=1))
+    rec["reused"] = reused
+    summary = {}
+    try:
+        summary = json.loads((outdir / "summary.json").read_text())
+    except (OSError, ValueError):
+        pass
+    for k in ("particles", "ghost_particles", "neighbours_min", "neighbours_mean",
+              "gradient_correction",
+              "neighbours_max", "support_over_dx", "hourglass_alpha", "cfl", "dt", "steps",
+              "simulated_time", "wall_seconds", "threads", "outcome", "residual",
+              "particle_steps_per_second"):
+        rec[k] = summary.get(k)
+    rec["qoi"] = None
+    try:
+        series = read_series(outdir / "probes.csv")
+        energies = read_series(outdir / "energies.csv")
+    except OSError:
+        series, energies = {}, {}
+    if energies:
+        rec["energy_drift_pct"] = energy_drift(energies)
+        rec["hourglass_work_min"] = min(energies.get("hourglass") or [0.0])
+    drift = rec.get("energy_drift_pct")
+    rec["energy_growth"] = bool(drift is not None and drift > ENERGY_GROWTH_PCT)
+    if rec.get("outcome") in ("finished", "converged", "not-converged") and series:
+        try:
+            rec["qoi"] = problem.extract(series, summary, R)
+        except (KeyError, ValueError, TypeError, ZeroDivisionError, IndexError) as e:
+            rec["qoi"] = None
+            rec["extract_error"] = "%s: %s" % (type(e).__name__, e)
+    if not problem.static and run["kind"] == "ladder" and series.get("time"):
+        rec["history"] = decimate(series, HISTORY_COLUMNS.get(problem.key, []))
+    return rec
+
+
+# Probe columns kept (decimated) in results.json for the time-history plots.
+HISTORY_COLUMNS = {"oscillating_plate": ["tip_uy"], "cantilever_dynamic": ["tip_uz"],
+                   "csm3": ["A_ux", "A_uy"]}
+
+
+def decimate(series, columns, points=1500):
+    n = len(series["time"])
+    step = max(1, n // points)
+    idx = list(range(0, n, step))
+    if idx[-1] != n - 1:
+        idx.append(n - 1)
+    out = {"time": [series["time"][i] for i in idx]}
+    for c in columns:
+        if c in series:
+            out[c] = [series[c][i] if math.isfinite(series[c][i]) else None for i in idx]
+    return out
+
+
+# --------------------------------------------------------------------------------------------
+# Results file
+
+
+def load_results(path):
+    try:
+        return json.loads(Path(path).read_text())
+    except (OSError, ValueError):
+        return None
+
+
+def save_json(path, data):
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_suffix(path.suffix + ".tmp")
+    tmp.write_text(json.dumps(data, indent=1, sort_keys=False) + "\n")
+    tmp.replace(path)
+
+
+def problems_table():
+    return {p.key: {"title": p.title, "scene": "validation/scenes/" + p.scene, "dim": p.dim,
+                    "thickness": p.thickness, "ladder": p.ladder, "quick_dx": p.quick_dx,
+                    "sensitivity_dx": p.sens_dx, "qoi": p.qoi, "unit": p.unit,
+                    "static": p.static, "target": p.target,
+                    "variants": [v for v, _ in p.variants], "checked": p.checked,
+                    "variant_overrides": {v: o for v, o in p.variants},
+                    "quick_variant": p.variants[p.quick_variant][0],
+                    "sensitivity_variant": p.variants[p.sens_variant][0],
+                    "variant_ladders": p.variant_ladders,
+                    "sensitivity": p.sensitivity, "cross": p.cross}
+            for p in PROBLEMS}
+
+
+# --------------------------------------------------------------------------------------------
+# Tolerances and the quick check
+
+MARGIN_PP, MARGIN_REL = 0.2, 0.10
+
+
+def derive_tolerances(results, path):
+    checks = {}
+    runs = {r["id"]: r for r in results["runs"]}
+    for p in PROBLEMS:
+        run = dict(problem=p.key, variant=p.variants[p.quick_variant][0], dx=p.quick_dx)
+        rid = run_id(p, run["variant"], run["dx"])
+        r = runs.get(rid)
+        if not r or not r.get("qoi"):
+            raise SystemExit("derive-tolerances: no result for %s in the report" % rid)
+        entry = {"outcome": r["outcome"], "errors": {}}
+        for name in p.checked:
+            e = r["qoi"]["errors"][name]
+            entry["errors"][name] = {
+                "report_pct": round(e, 4),
+                "max_abs_pct": round(abs(e) + max(MARGIN_PP, MARGIN_REL * abs(e)), 3)}
+        checks[rid] = entry
+    data = {
+        "about": "Quick-check tolerances (validation/run.py --quick --check), derived by "
+                 "validation/run.py --derive-tolerances from validation/report/results.json: "
+                 "for each checked error, max_abs_pct = |error in the full report at the same "
+                 "resolution and settings| + max(%.1f percentage points, %d %% of that error), "
+                 "a margin for compiler and platform differences only. Regenerate after a "
+                 "change of physics that the full report documents; never loosen by hand."
+                 % (MARGIN_PP, int(100 * MARGIN_REL)),
+        "derived_from": {"commit": results["meta"].get("git", {}).get("commit"),
+                         "generated": results["meta"].get("finished")},
+        "checks": checks,
+    }
+    save_json(path, data)
+    return data
+
+
+def check_against(tolerances, records):
+    """Returns (rows, ok). rows: (run id, quantity, error %, tolerance %, verdict)."""
+    rows, ok = [], True
+    recs = {r["id"]: r for r in records}
+    for rid, entry in tolerances["checks"].items():
+        r = recs.get(rid)
+        if r is None:
+            rows.append((rid, "-", None, None, "NOT RUN"))
+            ok = False
+            continue
+        if r.get("outcome") != entry["outcome"]:
+            rows.append((rid, "outcome", None, None,
+                         "FAIL (%s, expected %s)" % (r.get("outcome"), entry["outcome"])))
+            ok = False
+            continue
+        for name, tol in entry["errors"].items():
+            e = (r.get("qoi") or {}).get("errors", {}).get(name)
+            good = e is not None and abs(e) <= tol["max_abs_pct"]
+            ok &= good
+            rows.append((rid, name, e, tol["max_abs_pct"], "ok" if good else "FAIL"))
+    return rows, ok
+
+
+# --------------------------------------------------------------------------------------------
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
+                                 formatter_class=argparse.RawDescriptionHelpFormatter,
+                                 epilog=__doc__.split("\n\n", 1)[1])
+    ap.add_argument("--quick", action="store_true",
+                    help="one coarse resolution per problem, no sensitivities")
+    ap.add_argument("--check", action="store_true",
+                    help="compare the errors with validation/tolerances.json; exit 1 on failure")
+    ap.add_argument("--report-only", action="store_true",
+                    help="regenerate README.md and plots from results.json, run nothing")
+    ap.add_argument("--derive-tolerances", action="store_true",
+                    help="write validation/tolerances.json from the report's results.json")
+    ap.add_argument("--plan", action="store_true", help="list the runs and exit")
+    ap.add_argument("--threads", type=int, default=os.cpu_count() or 1,
+                    help="OMP_NUM_THREADS for every run (default: all cores, %(default)s)")
+    ap.add_argument("--omp-wait-policy", default="passive", choices=["passive", "active", ""],
+                    help="OMP_WAIT_POLICY for every run (default: %(default)s: idle threads "
+                         "sleep, so a machine shared with other jobs does not collapse the "
+                         "throughput of spinning barriers; '' leaves the OpenMP default)")
+    ap.add_argument("--binary-commit", default="",
+                    help="the commit the binary was built from when that is not the working "
+                         "tree (an export made with `git archive COMMIT`); recorded instead of "
+                         "the working tree's state")
+    ap.add_argument("--build-dir", default=str(ROOT / "build"),
+                    help="where build/tlsph is (default: %(default)s)")
+    ap.add_argument("--runs-dir", default=None,
+                    help="where the runs' output directories go (default: validation/runs, "
+                         "or validation/runs/quick with --quick)")
+    ap.add_argument("--report-dir", default=str(HERE / "report"),
+                    help="README.md, results.json, plots (default: %(default)s)")
+    ap.add_argument("--tolerances", default=str(HERE / "tolerances.json"))
+    ap.add_argument("--only", default="",
+                    help="comma-separated problems (%s); their runs replace those in "
+                         "results.json, the others are kept" % ", ".join(BY_KEY))
+    ap.add_argument("--no-sensitivity", action="store_true", help="ladders only")
+    ap.add_argument("--reuse", action="store_true",
+                    help="reuse a run directory whose last run had the same command and is "
+                         "newer than its scene file (for development and for resuming an "
+                         "interrupted ladder: the binary and commit are not compared)")
+    ap.add_argument("--timeout", type=float, default=3600.0, help="seconds per run")
+    args = ap.parse_args(argv)
+
+    args.build_dir = str(Path(args.build_dir).resolve())
+    args.report_dir = str(Path(args.report_dir).resolve())
+    args.tolerances = str(Path(args.tolerances).resolve())
+    if args.runs_dir:
+        args.runs_dir = str(Path(args.runs_dir).resolve())
+    only = [s for s in args.only.split(",") if s]
+    for s in only:
+        if s not in BY_KEY:
+            ap.error("unknown problem %r (one of %s)" % (s, ", ".join(BY_KEY)))
+    report_dir = Path(args.report_dir)
+    results_path = report_dir / "results.json"
+
+    if args.report_only:
+        import report
+        results = load_results(results_path)
+        if not results:
+            raise SystemExit("no %s: run the ladder first" % rel(results_path))
+        report.write_report(results, report_dir)
+        print("wrote %s and plots" % rel(report_dir / "README.md"))
+        return 0
+    if args.derive_tolerances:
+        results = load_results(results_path)
+        if not results:
+            raise SystemExit("no %s: run the ladder first" % rel(results_path))
+        data = derive_tolerances(results, args.tolerances)
+        print("wrote %s (%d checks)" % (rel(args.tolerances), len(data["checks"])))
+        return 0
+
+    runs_dir = Path(args.runs_dir) if args.runs_dir else (
+        HERE / "runs" / "quick" if args.quick else HERE / "runs")
+    plan = plan_runs(args.quick, not args.no_sensitivity, only)
+    for r in plan:
+        r["threads"] = args.threads
+        r["wait_policy"] = args.omp_wait_policy
+    if args.plan:
+        for r in plan:
+            print("%-45s %s" % (r["id"], build_command(BY_KEY[r["problem"]], r, args.build_dir,
+                                                       runs_dir)[2]))
+        print("%d runs" % len(plan))
+        return 0
+
+    tlsph = Path(args.build_dir) / "tlsph"
+    if not tlsph.exists():
+        raise SystemExit("%s not found: build first (bash scripts/setup.sh build) or pass "
+                         "--build-dir" % tlsph)
+    tolerances = None
+    if args.check:
+        try:
+            tolerances = json.loads(Path(args.tolerances).read_text())
+        except (OSError, ValueError) as e:
+            raise SystemExit("cannot read %s: %s" % (args.tolerances, e))
+
+    R = compute_references()
+    git = git_state()
+    if args.binary_commit:
+        git = {"commit": args.binary_commit, "binary_built_from_export": True,
+               "working_tree": git, "changed": []}
+    started = time.strftime("%Y-%m-%d %H:%M:%S %Z")
+    t_start = time.monotonic()
+    meta = {"runner_command": " ".join(["/usr/bin/python3", "validation/run.py"] +
+                                       [shlex.quote(a) for a in (argv or sys.argv[1:])]),
+            "started": started, "git": git,
+            "machine": machine_info(args.threads, args.build_dir),
+            "omp_wait_policy": args.omp_wait_policy,
+            "quick": args.quick}
+
+    if args.quick:
+        out_path = runs_dir / "quick-results.json"
+        previous = None
+    else:
+        out_path = results_path
+        previous = load_results(results_path) if only else None
+    kept = [r for r in (previous or {}).get("runs", []) if r["problem"] not in only]
+    records = []
+
+    def save():
+        data = {"schema": 1, "meta": dict(meta), "references": R, "problems": problems_table(),
+                "runs": kept + records}
+        if previous and only:
+            data["meta"]["merged_with"] = previous.get("meta")
+        save_json(out_path, data)
+        return data
+
+    print("tlsph validation: %d runs, %d threads, runs in %s" % (len(plan), args.threads,
+                                                                 rel(runs_dir)))
+    print("%-40s %9s %6s %8s %8s  %-13s %s" % ("run", "particles", "nb", "steps", "wall s",
+                                               "outcome", "error %"))
+    for r in plan:
+        p = BY_KEY[r["problem"]]
+        rec = execute(p, r, args.build_dir, runs_dir, R, git, args.reuse, args.timeout)
+        records.append(rec)
+        q = rec.get("qoi")
+        err = q["errors"].get(q["primary"]) if q else None
+        print("%-40s %9s %6s %8s %8s  %-13s %s" % (
+            rec["id"], rec.get("particles"),
+            "%.1f" % rec["neighbours_mean"] if rec.get("neighbours_mean") else "-",
+            rec.get("steps"), "%.1f" % rec["wall_runner"], rec.get("outcome") or rec.get("rc"),
+            "%+.3f (%s)" % (err, q["primary"]) if err is not None else "-"), flush=True)
+        meta["elapsed_seconds"] = time.monotonic() - t_start
+        save()
+    meta["finished"] = time.strftime("%Y-%m-%d %H:%M:%S %Z")
+    meta["elapsed_seconds"] = time.monotonic() - t_start
+    data = save()
+    print("total %.0f s (sum of run wall times %.0f s); results in %s" % (
+        meta["elapsed_seconds"], sum(r["wall_runner"] for r in records), rel(out_path)))
+
+    status = 0
+    if not args.quick:
+        try:
+            import report
+            report.write_report(data, report_dir)
+            print("wrote %s and plots" % rel(report_dir / "README.md"))
+        except ImportError as e:
+            print("no report plots (%s): install python3-numpy python3-matplotlib, then "
+                  "run with --report-only" % e)
+    if args.check:
+        rows, ok = check_against(tolerances, records)
+        print()
+        print("%-36s %-26s %10s %10s  %s" % ("run", "error", "error %", "max |%|", "verdict"))
+        for rid, name, e, tol, verdict in rows:
+            print("%-36s %-26s %10s %10s  %s" % (rid, name, "%+.3f" % e if e is not None else "-",
+                                                "%.3f" % tol if tol is not None else "-",
+                                                verdict))
+        print("validation check: %s" % ("PASSED" if ok else "FAILED"))
+        status = 0 if ok else 1
+    return status
+
+
+if __name__ == "__main__":
+    sys.exit(main())
