@@ -212,7 +212,7 @@ CONVERGENCE = {
 }
 # The quantity an error is of, for legends and tables.
 ERROR_SYMBOL = {"period": "T", "period_vs_timoshenko": "T", "tip": "w", "tip_vs_fem": "w",
-                "frequency": "f", "frequency_vs_euler_bernoulli": "f", "displacement": "|u|",
+                "frequency": "f", "frequency_vs_euler_bernoulli": "f", "displacement": "abs(u)",
                 "uy": "u_y", "ux": "u_x", "uy_amp": "u_y amplitude", "uy_mean": "u_y mean",
                 "w": "w", "w_vs_mindlin": "w"}
 
@@ -274,11 +274,13 @@ def readme(data, plots, plot_note):
     L.append("| commit | `%s` |" % git.get("commit", "?"))
     if git.get("binary_built_from_export"):
         wt = git.get("working_tree", {})
-        L.append("| binary | built from `git archive %s` (an export of the commit: the working "
-                 "tree, `%s`, had uncommitted changes of others in progress: %s); scenes and "
-                 "runner from the working tree |" % (
-                     git.get("commit", "?")[:12], wt.get("commit", "?")[:12] + "...",
-                     ", ".join("`%s`" % c[3:] for c in wt.get("changed", [])[:10])))
+        changed = ", ".join("`%s`" % c[3:] for c in wt.get("changed", [])[:10])
+        L.append("| binary | built from `git archive %s` (a clean export of the commit, so that "
+                 "work in progress in the shared tree could not enter it); scenes and runner "
+                 "from the working tree%s |" % (
+                     git.get("commit", "?")[:12],
+                     ", where these files differed from the commit: " + changed
+                     if changed else ""))
     if git.get("changed"):
         L.append("| uncommitted at run time | %s |" % ", ".join(
             "`%s`" % c[3:] for c in git["changed"][:12]) + (" ..." if len(git["changed"]) > 12
@@ -290,7 +292,12 @@ def readme(data, plots, plot_note):
                                                    m.get("tlsph_version", "")))
     L.append("| threads | OMP_NUM_THREADS=%s, OMP_WAIT_POLICY=%s |" % (
         m.get("threads", "?"), meta.get("omp_wait_policy") or "(default)"))
-    L.append("| runs | %d, started %s |" % (len(runs), meta.get("started", "?")))
+    reused = sum(1 for r in runs if r.get("reused"))
+    L.append("| runs | %d, started %s%s |" % (
+        len(runs), meta.get("started", "?"),
+        "; %d of them reused from an earlier invocation of the same ladder (`--reuse`: same "
+        "command, run after the scene file last changed; their wall times are those measured "
+        "then)" % reused if reused else ""))
     L.append("| wall time | %.0f s for all runs (%.1f min), of which the ladders %.0f s and "
              "the sensitivity studies %.0f s |" % (
                  total_wall, total_wall / 60.0,
@@ -359,8 +366,9 @@ def readme(data, plots, plot_note):
     L.append("## Sensitivity studies")
     L.append("")
     L.append("One resolution per problem (the 'mid' one of its ladder); one parameter changed "
-             "at a time from the defaults (support 2.1 dx, alpha 10, CFL 0.3, static tolerance "
-             "1e-5 in the validation scenes); the default row is the ladder run. Exit status 4 "
+             "at a time from the defaults (support 2.1 dx, quadratic correction, alpha 10, CFL "
+             "0.3, static tolerance 1e-5 in the validation scenes); the default row is the "
+             "ladder run. Exit status 4 "
              "(`unstable`) is a result. `hg work min` is the most negative value the hourglass "
              "work reached (a negative value means the hourglass force fed energy in).")
     L.append("")
@@ -440,7 +448,9 @@ NOTES = {
     "cantilever_dynamic": "Frequency from the crossings of the tip u_z through its mean "
                           "(max+min)/2 over 0 < t <= 1.9 s (about 3 periods, 6 crossings).",
     "csm1": "abs(u) error = |u - u_ref| / |u_ref| for the displacement vector of point A (the "
-            "headline); the components separately. Extrapolated: `2 u(0.33) - u(0.31)`.",
+            "headline); the components separately: u_x and u_y are negative, so a positive "
+            "component error means a smaller magnitude (too stiff), a negative one too soft. "
+            "Extrapolated: `2 u(0.33) - u(0.31)`.",
     "csm3": "Over t >= 0.9095 s to the end (3.0 s): about 2.3 periods.",
     "clamped_plate": "Centre deflection from the kernel probe at the mid-surface centre.",
 }
@@ -487,7 +497,8 @@ def problem_section(key, p, runs, R):
                     rich = "p = %.2f, value %s, error %+.2f %%" % (
                         pr, g(qinf, 5), 100 * (qinf - ref) / abs(ref))
                 elif pr is None:
-                    rich = "not monotone"
+                    rich = "no fit (differences change sign or shrink too slowly: not " \
+                           "in the asymptotic range)"
             conv_rows.append([error_label(name, against),
                               "; ".join(orders), rich])
         if conv_rows:
@@ -624,16 +635,20 @@ def defaults_section(P, runs):
 
 def cuts_section(P, runs):
     L = ["## What was cut to keep the ladder near 30 minutes on 2 cores", ""]
-    L.append("- The sensitivity studies run at one resolution per problem (the second of its "
-             "ladder), one parameter at a time. The 3D dynamic cantilever has only alpha 0 and "
-             "3, the linear correction and CFL 0.4, from its alpha = 1 ladder run (the static "
-             "cantilever, same beam, has the full study); CSM3 has support 2.5 and 3.0, alpha 0 "
-             "and 50, CFL 0.4 and 0.5 and the linear correction (CSM1, same beam, has the full "
+    L.append("- Sensitivity studies run at one resolution per problem (the second of its "
+             "ladder), one parameter at a time.")
+    L.append("- The 3D dynamic cantilever's study has only alpha 3, the linear correction and "
+             "CFL 0.4, from its alpha = 1 ladder run (each run costs about a minute; the static "
+             "cantilever, same beam, has the full study). CSM3's has support 2.5 and 3.0, alpha "
+             "0 and 50, CFL 0.4 and the linear correction (CSM1, same beam, has the full "
              "study).")
-    L.append("- CFL 0.1 is run for the oscillating plate only (and, with alpha 50 and 100, for "
-             "the plate and CSM1, to tell a time-step limit from an instability of the "
-             "equations); for a static problem the step changes only the path to equilibrium, "
-             "and 3D runs at CFL 0.1 cost three times as much.")
+    L.append("- alpha = 100 is not run for the 3D static cantilever (with a stiff penalty "
+             "kinetic damping needs ten times the steps: 2-3 minutes a run; alpha 50 there "
+             "shows the trend).")
+    L.append("- CFL 0.1 only on the oscillating plate (alone, and with alpha 50 and 100, to tell "
+             "a time-step limit from an instability of the equations); for a static problem "
+             "the step changes only the path to equilibrium, and CFL 0.4, 0.5 and 0.6 show that "
+             "below the limit the step does not change the results.")
     L.append("- CSM3 is simulated to 3.0 s (about 3.3 periods; the window after the first "
              "period holds about 2.3 periods) rather than 4 periods or more.")
     L.append("- The static scenes stop at a residual of 1e-5 (the sensitivity tables show "
@@ -650,12 +665,20 @@ def cuts_section(P, runs):
 # Plots
 
 
+def _minor_label(v, digits):
+    """A minor tick label on a log axis for the leading digits given ('0.3', '20'), else ''."""
+    text = "%g" % v
+    lead = text.lstrip("0.")
+    return text if lead and lead[0] in digits else ""
+
+
 def make_plots(data, report_dir):
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     import numpy as np
+    from matplotlib.ticker import FixedLocator, FuncFormatter, NullFormatter
 
     runs, R, P = data["runs"], data["references"], data["problems"]
     out = []
@@ -678,6 +701,10 @@ def make_plots(data, report_dir):
             for r, xx, yy in zip(lad, x, y):
                 ax.annotate("%d" % r["per_thickness"], (xx, yy), textcoords="offset points",
                             xytext=(4, 4), fontsize=7, color=colours[i % len(colours)])
+    ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: "%g" % v))
+    ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: "%g" % v))
+    ax.yaxis.set_minor_formatter(FuncFormatter(lambda v, _: _minor_label(v, "25")))
+    ax.tick_params(axis="y", which="minor", labelsize=7)
     ax.set_xlabel("wall time of the run [s] (2 cores)")
     ax.set_ylabel("|error| against the reference [%]")
     ax.set_title("Error against run time (labels: particles through the thickness)")
@@ -726,6 +753,14 @@ def make_plots(data, report_dir):
             ax.text(ax.get_xlim()[0], tgt[1], " target %g %%" % tgt[1], fontsize=7,
                     va="bottom", color="grey")
         ax.set_title(p["title"].split(",")[0].split(" (")[0] + " — " + p["qoi"], fontsize=9)
+        # label the ladder's dx values themselves, in plain numbers
+        dxs = sorted({r["dx"] for r in ladder(runs, key)})
+        ax.xaxis.set_major_locator(FixedLocator(dxs))
+        ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: "%.3g" % v))
+        ax.xaxis.set_minor_formatter(NullFormatter())
+        ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: "%g" % v))
+        ax.yaxis.set_minor_formatter(FuncFormatter(lambda v, _: _minor_label(v, "235")))
+        ax.tick_params(axis="both", which="both", labelsize=7)
         ax.set_xlabel("dx [m]")
         ax.set_ylabel("|error| [%]")
         ax.grid(True, which="both", alpha=0.3)
@@ -790,12 +825,12 @@ def make_plots(data, report_dir):
     ax.plot(tt, d * (1 - np.cos(2 * np.pi * c["f_timoshenko"] * tt)) * MM, "k--", lw=1,
             label="one-mode reference: static Timoshenko w (1 - cos 2 pi f t), f = %.4f Hz"
                   % c["f_timoshenko"])
-    ax.set_ylim(-5, 40)
+    ax.set_ylim(-5, 55)
     ax.set_xlabel("t [s]")
     ax.set_ylabel("tip deflection -u_z [mm]")
     ax.set_title("Cantilever, gravity applied suddenly", fontsize=10)
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=7.5, loc="upper right")
+    ax.legend(fontsize=7.5, loc="upper center", ncol=2)
     fig.tight_layout()
     fig.savefig(report_dir / "history_cantilever_dynamic.png", dpi=110)
     plt.close(fig)
@@ -804,7 +839,7 @@ def make_plots(data, report_dir):
                 "its record ends; the axis is clipped), with the one-mode reference."))
 
     cs = R["csm3"]
-    fig, axes = plt.subplots(2, 1, figsize=(9, 7), sharex=True)
+    fig, axes = plt.subplots(2, 1, figsize=(11.5, 7), sharex=True)
     for ax, comp in zip(axes, ("ux", "uy")):
         mean, amp = cs[comp + "_mean"], cs[comp + "_amp"]
         ax.axhspan((mean - amp) * MM, (mean + amp) * MM, color="0.9",
@@ -822,7 +857,7 @@ def make_plots(data, report_dir):
         ax.axvline(1 / 1.0995, color="grey", lw=0.8)
         ax.set_ylabel("point A u_%s [mm]" % comp[1])
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=7.5, loc="lower right")
+        ax.legend(fontsize=7.5, loc="center left", bbox_to_anchor=(1.01, 0.5))
     axes[0].set_title("Turek-Hron CSM3 (the window for mean, amplitude and frequency starts at "
                       "the grey line)", fontsize=10)
     axes[-1].set_xlabel("t [s]")
@@ -834,37 +869,66 @@ def make_plots(data, report_dir):
                 "mean +- amplitude (dashed: mean; dotted: the extremes)."))
 
     # 4. sensitivities
+    # The clamped plate is shown against Mindlin (its Kirchhoff error is mostly the model's).
+    # CSM1 by the magnitude of u_y (its headline, a vector norm, has no sign).
+    plot_error = {"clamped_plate": "w_vs_mindlin", "csm1": "uy"}
+    plot_sign = {"csm1": -1.0}
+    plot_label = {"clamped_plate": " (w vs Mindlin)", "csm1": " (abs(u_y))"}
+
+    def sens_error(r, key):
+        q = r.get("qoi")
+        e = q["errors"].get(plot_error.get(key, q["primary"])) if q else None
+        return None if e is None else plot_sign.get(key, 1.0) * e
+
     params = ["kernel.support", "hourglass.alpha", "time.cfl"]
-    fig, axes = plt.subplots(1, 3, figsize=(14, 4.5))
+    fig, axes = plt.subplots(1, 3, figsize=(15, 5))
     for ax, param in zip(axes, params):
+        k = 0
         for i, (key, p) in enumerate(P.items()):
             if param not in p.get("sensitivity", {}):
                 continue
+            colour = colours[i % len(colours)]
             base = base_run(runs, key, p)
             rs = sensitivity(runs, key, param) + ([dict(base, value=base_value(p, param))]
                                                   if base else [])
             rs = sorted(rs, key=lambda r: r["value"])
-            x = [r["value"] for r in rs if primary_error(r) is not None and
-                 r.get("outcome") != "unstable" and not r.get("energy_growth")]
-            y = [primary_error(r) for r in rs if primary_error(r) is not None and
-                 r.get("outcome") != "unstable" and not r.get("energy_growth")]
-            bad = [r["value"] for r in rs if r.get("outcome") == "unstable" or
-                   r.get("energy_growth")]
-            ax.plot(x, y, "o-", color=colours[i % len(colours)], label=key)
-            for b in bad:
-                ax.plot([b], [0], "x", color=colours[i % len(colours)], ms=9, mew=2)
+            good = [r for r in rs if sens_error(r, key) is not None and
+                    r.get("outcome") != "unstable" and not r.get("energy_growth")]
+            label = key + plot_label.get(key, "")
+            sv = p.get("sensitivity_variant", "")
+            if p.get("variant_overrides", {}).get(sv):
+                label += " (" + variant_label(p, sv) + ")"
+            ax.plot([r["value"] for r in good], [sens_error(r, key) for r in good], "o-",
+                    color=colour, label=label)
+            # failed runs: a cross (unstable or energy growth) or a triangle (set-up error)
+            # at the bottom of the axis, staggered per problem so none hides another
+            yb = -26 - 1.6 * k
+            k += 1
+            for r in rs:
+                if r.get("outcome") == "unstable" or r.get("energy_growth"):
+                    ax.plot([r["value"]], [yb], "x", color=colour, ms=8, mew=2)
+                elif r.get("rc") == 1:
+                    ax.plot([r["value"]], [yb], "v", color=colour, ms=7, mfc="white")
         ax.axvline(DEFAULTS[param], color="grey", lw=0.8, ls="--")
+        ax.axhline(0, color="k", lw=0.6)
         if param == "hourglass.alpha":
             ax.set_xscale("symlog", linthresh=1.0)
-        ax.set_xlabel(param + "  (x at 0: unstable or energy grows)")
+            ax.set_xlim(-0.3, 130)
+        ax.set_ylim(-36, 40)
+        ax.set_xlabel(param)
         ax.set_ylabel("headline error [%]")
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=7)
+        ax.legend(fontsize=7, loc="upper left")
+    fig.suptitle("Sensitivities at each problem's middle resolution; below -25 %: x = unstable "
+                 "or energy grows, triangle = set-up error", fontsize=10)
     fig.tight_layout()
     fig.savefig(report_dir / "sensitivity.png", dpi=110)
     plt.close(fig)
     out.append(("sensitivity.png",
-                "headline signed error against each parameter at the sensitivity resolution "
-                "(dashed line: the default); a cross on the axis marks a value at which the run "
-                "went unstable or its energy grew."))
+                "signed headline error against each parameter at the sensitivity resolution "
+                "(dashed line: the default; the clamped plate against Mindlin, CSM1 by the "
+                "magnitude of u_y). For deflections and periods a positive error means too "
+                "soft, for frequencies too stiff. Runs that went "
+                "unstable or gained energy (x) and set-up errors (triangles) are marked in the "
+                "band below -25 %, one row per problem."))
     return out
