@@ -16,7 +16,7 @@ using namespace tlsph;
 int main(int argc, char** argv) {
   double dx = 0.0125, supportRatio = 2.1, alpha = 10.0;
   long steps = 200;
-  std::string material = "neo-hookean", correction = "linear";
+  std::string material = "neo-hookean", correction = "linear", form = "energy";
   po::options_description options("tlsph_bench: 3D cantilever throughput");
   options.add_options()("help", "this help")("dx", po::value(&dx)->default_value(dx),
                                              "particle spacing [m] (0.0125: 80 x 8 x 8)")(
@@ -26,7 +26,8 @@ int main(int argc, char** argv) {
       "material", po::value(&material)->default_value(material), "material model")(
       "steps", po::value(&steps)->default_value(steps), "time steps to time")(
       "correction", po::value(&correction)->default_value(correction),
-      "gradient correction: linear or quadratic");
+      "gradient correction: linear or quadratic")("form", po::value(&form)->default_value(form),
+                                                  "hourglass form: energy or ganzenmueller");
   po::variables_map vm;
   po::store(po::parse_command_line(argc, argv, options), vm);
   po::notify(vm);
@@ -40,6 +41,7 @@ int main(int argc, char** argv) {
       makeMaterial(material, ElasticConstants::fromYoungPoisson(1.0e7, 0.3), 1000.0));
   scene.supportRadius = supportRatio * dx;
   scene.hourglassCoefficient = alpha;
+  scene.hourglassForm = parseHourglassForm(form);
   scene.gradientCorrection = parseGradientCorrection(correction);
   scene.gravity = Vec3(0, 0, -1.0);
   const int nx = static_cast<int>(std::lround(1.0 / dx));
@@ -57,7 +59,7 @@ int main(int argc, char** argv) {
   std::cout << "particles " << scene.particles.size() << " (" << nx * ny * ny << " body), "
             << "mean neighbours " << double(nb.pairCount()) / nb.particleCount() << ", threads "
             << omp_get_max_threads() << ", dt " << solver.timeStep() << ", " << correction
-            << " correction\n";
+            << " correction, hourglass " << form << "\n";
   solver.step();  // warm-up
   const auto start = std::chrono::steady_clock::now();
   for (long s = 0; s < steps; ++s)

@@ -31,8 +31,9 @@ std::vector<Vec<D>> perturbedBlock(const std::array<int, D>& counts, double dx, 
 
 template <int D>
 Scene<D> sceneOf(const std::vector<Vec<D>>& X, double dx, double supportRatio, Material material,
-                 double alpha = 0.0) {
+                 double alpha = 0.0, HourglassForm form = HourglassForm::Energy) {
   Scene<D> scene;
+  scene.hourglassForm = form;
   scene.materials.push_back(std::move(material));
   scene.supportRadius = supportRatio * dx;
   scene.hourglassCoefficient = alpha;
@@ -48,12 +49,12 @@ class ForceEvaluator {
  public:
   explicit ForceEvaluator(Scene<D> scene)
       : scene_(std::move(scene)),
-        ref_(buildReferenceConfiguration<D>(
-            scene_.particles.referencePosition, scene_.particles.volume,
-            Kernel<D>(scene_.kernel, scene_.supportRadius), scene_.periodicBox,
-            scene_.gradientCorrection)),
+        ref_(buildReferenceConfiguration<D>(scene_.particles.referencePosition,
+                                            scene_.particles.volume,
+                                            Kernel<D>(scene_.kernel, scene_.supportRadius),
+                                            scene_.periodicBox, scene_.gradientCorrection)),
         forces_(ref_, scene_.materials, scene_.particles.material, scene_.particles.volume,
-                scene_.hourglassCoefficient) {}
+                scene_.hourglass()) {}
   ForceEvaluator(const ForceEvaluator&) = delete;
   ForceEvaluator& operator=(const ForceEvaluator&) = delete;
 
@@ -67,9 +68,11 @@ class ForceEvaluator {
     forces_.compute(u, f);
     return f;
   }
+  // Strain energy plus the energy-form hourglass energy: the total whose negative gradient
+  // is the force.
   double energy(const std::vector<Vec<D>>& u) {
     force(u);
-    return forces_.strainEnergy();
+    return forces_.strainEnergy() + forces_.hourglassEnergy(u);
   }
   std::vector<Vec<D>> currentPositions(const std::vector<Vec<D>>& u) const {
     std::vector<Vec<D>> x(size());

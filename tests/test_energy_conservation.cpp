@@ -105,7 +105,8 @@ TEST(EnergyConservation, WithoutHourglassTheBooksStillBalance) {
   EXPECT_LT(d.momentum, 1e-12);
 }
 
-// The quadratic correction with the hourglass penalty on its own (linear) F: the same books.
+// The defaults (quadratic correction, energy-form penalty alpha = 10 on the same F): the same
+// books, with E_hg a state function in them.
 TEST(EnergyConservation, FreeVibrationQuadraticCorrection) {
   const auto q = GradientCorrection::Quadratic;
   const Drift d2 = freeVibration<2>("neo-hookean", 10.0, 3000, kDefaultCfl, q);

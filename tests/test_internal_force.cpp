@@ -1,5 +1,6 @@
 // The internal force is minus the gradient of the discrete strain energy E = sum V_I psi(F_I)
 // (which pins the sign of (6.70) and the transpose of L), and it conserves linear momentum.
+// With the energy-form hourglass penalty, the force is minus the gradient of E + E_hg.
 #include <gtest/gtest.h>
 
 #include "TestSupport.hpp"
@@ -21,13 +22,17 @@ std::vector<Vec<D>> randomDeformation(const ForceEvaluator<D>& eval, double dx, 
 
 template <int D>
 void expectForceIsMinusEnergyGradient(const std::string& material, std::uint32_t seed,
-                                      GradientCorrection correction = GradientCorrection::Linear) {
+                                      GradientCorrection correction = GradientCorrection::Linear,
+                                      double alpha = 0.0,
+                                      HourglassGradient gradient = HourglassGradient::Corrected) {
   std::mt19937 rng(seed);
   const double dx = 0.01;
   std::array<int, D> counts;
   counts.fill(D == 2 ? 6 : 4);
-  auto scene = sceneOf<D>(perturbedBlock<D>(counts, dx, 0.2, rng), dx, 2.5, testMaterial(material));
+  auto scene = sceneOf<D>(perturbedBlock<D>(counts, dx, 0.2, rng), dx, 2.5, testMaterial(material),
+                          alpha, HourglassForm::Energy);
   scene.gradientCorrection = correction;
+  scene.hourglassGradient = gradient;
   ForceEvaluator<D> eval(std::move(scene));
   auto u = randomDeformation(eval, dx, rng);
   const auto f = eval.force(u);
@@ -49,7 +54,7 @@ void expectForceIsMinusEnergyGradient(const std::string& material, std::uint32_t
       const double minusGradient = -(Eplus - Eminus) / (2 * h);
       worst = std::max(worst, std::abs(minusGradient - f[i][a]));
     }
-  EXPECT_LT(worst, 1e-6 * fmax) << material << " in " << D << "D";
+  EXPECT_LT(worst, 1e-6 * fmax) << material << " in " << D << "D, alpha " << alpha;
 }
 
 template <int D>
@@ -103,6 +108,18 @@ TEST_P(InternalForce, IsMinusEnergyGradientQuadraticCorrection3D) {
 TEST_P(InternalForce, ConservesLinearMomentumQuadraticCorrection) {
   expectZeroTotalForce<2>(GetParam(), 5.0, 29, GradientCorrection::Quadratic);
   expectZeroTotalForce<3>(GetParam(), 5.0, 30, GradientCorrection::Quadratic);
+}
+
+// The energy-form penalty (the default): f = -d(E + E_hg)/du with either correction and either
+// F in e_IJ; alpha = 10 makes the penalty a large part of the force on a noisy field.
+TEST_P(InternalForce, WithEnergyHourglassIsMinusEnergyGradient) {
+  const auto lin = GradientCorrection::Linear, quad = GradientCorrection::Quadratic;
+  expectForceIsMinusEnergyGradient<2>(GetParam(), 31, lin, 10.0);
+  expectForceIsMinusEnergyGradient<3>(GetParam(), 32, lin, 10.0);
+  expectForceIsMinusEnergyGradient<2>(GetParam(), 33, quad, 10.0);
+  expectForceIsMinusEnergyGradient<3>(GetParam(), 34, quad, 10.0);
+  expectForceIsMinusEnergyGradient<2>(GetParam(), 35, quad, 10.0, HourglassGradient::Linear);
+  expectForceIsMinusEnergyGradient<3>(GetParam(), 36, quad, 10.0, HourglassGradient::Linear);
 }
 
 INSTANTIATE_TEST_SUITE_P(Materials, InternalForce,

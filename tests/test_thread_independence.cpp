@@ -25,9 +25,11 @@ std::vector<Vec3> runWithThreads(int threads) {
   auto scene = sceneOf<3>(perturbedBlock<3>({12, 5, 5}, dx, 0.1, rng), dx, 2.1,
                           testMaterial("neo-hookean"), 5.0);
   scene.gravity = Vec3(0.0, 0.0, -9.81);
-  for (auto& v : scene.particles.velocity) v = randomVector<3>(rng, 0.5);
+  for (auto& v : scene.particles.velocity)
+    v = randomVector<3>(rng, 0.5);
   Solver<3> solver(scene);
-  for (int s = 0; s < 50; ++s) solver.step();
+  for (int s = 0; s < 50; ++s)
+    solver.step();
   return scene.particles.displacement;
 }
 
@@ -37,5 +39,6 @@ TEST(ThreadIndependence, OneAndTwoThreadsGiveBitwiseEqualResults) {
   const auto one = runWithThreads(1);
   const auto two = runWithThreads(2);
   ASSERT_EQ(one.size(), two.size());
-  for (std::size_t i = 0; i < one.size(); ++i) ASSERT_EQ(one[i], two[i]) << "particle " << i;
+  for (std::size_t i = 0; i < one.size(); ++i)
+    ASSERT_EQ(one[i], two[i]) << "particle " << i;
 }

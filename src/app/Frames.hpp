@@ -34,8 +34,17 @@ std::vector<double> hourglassError(const ReferenceConfiguration<D>& ref,
   return out;
 }
 
+// Every field name makeFrame knows, in the order of docs/scene-format.md ([output] fields).
+inline const std::vector<std::string>& allFrameFields() {
+  static const std::vector<std::string> names = {"displacement",    "velocity",      "J",
+                                                 "von_mises",       "cauchy_stress", "first_piola",
+                                                 "hourglass_error", "flags"};
+  return names;
+}
+
 template <int D>
-Frame makeFrame(const SceneSetup<D>& setup, const Solver<D>& solver) {
+Frame makeFrame(const SceneSetup<D>& setup, const Solver<D>& solver,
+                const std::vector<std::string>& fields) {
   const auto& p = setup.scene.particles;
   const Index n = p.size();
   Frame frame;
@@ -64,7 +73,7 @@ Frame makeFrame(const SceneSetup<D>& setup, const Solver<D>& solver) {
         },
         setup.scene.materials[p.material[i]]);
   };
-  for (const auto& name : setup.output.fields) {
+  for (const auto& name : fields) {
     if (name == "displacement") {
       vectorField(name, p.displacement);
     } else if (name == "velocity") {
@@ -105,6 +114,12 @@ Frame makeFrame(const SceneSetup<D>& setup, const Solver<D>& solver) {
     }
   }
   return frame;
+}
+
+// The fields the scene asked for.
+template <int D>
+Frame makeFrame(const SceneSetup<D>& setup, const Solver<D>& solver) {
+  return makeFrame(setup, solver, setup.output.fields);
 }
 
 }  // namespace tlsph

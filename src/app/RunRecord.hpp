@@ -72,11 +72,25 @@ void writeRunRecord(const std::filesystem::path& file, const SceneSetup<D>& setu
   field("kernel", jsonText(std::string(kernelName(setup.scene.kernel))));
   field("gradient_correction", jsonText(gradientCorrectionName(setup.scene.gradientCorrection)));
   field("hourglass_alpha", jsonNumber(setup.scene.hourglassCoefficient));
+  field("hourglass_form", jsonText(hourglassFormName(setup.scene.hourglassForm)));
+  field("hourglass_gradient", jsonText(hourglassGradientName(setup.scene.hourglassGradient)));
+  field("viscosity_linear", jsonNumber(setup.scene.viscosity.linear));
+  field("viscosity_quadratic", jsonNumber(setup.scene.viscosity.quadratic));
   field("neighbours_min", std::to_string(nb.min));
   field("neighbours_mean", jsonNumber(nb.mean));
   field("neighbours_max", std::to_string(nb.max));
   field("cfl", jsonNumber(setup.solver.cfl));
   field("dt", jsonNumber(s.timeStep));
+  // The step rule dt = cfl dx / sqrt(c^2 + c_hg^2) at the limiting particle (also when
+  // [time] dt overrides it): the predicted critical step is dt_rule / cfl times the measured
+  // critical C (about 0.5 with the quadratic correction, validation/report/stability.md).
+  field("dt_rule", jsonNumber(s.stableStep.dt));
+  field("dt_rule_particle", std::to_string(s.stableStep.particle));
+  field("dt_rule_wave_speed", jsonNumber(s.stableStep.waveSpeed));
+  field("dt_rule_hourglass_speed", jsonNumber(s.stableStep.hourglassSpeed));
+  field("dt_rule_limited_by",
+        jsonText(s.stableStep.hourglassSpeed > s.stableStep.waveSpeed ? "hourglass penalty"
+                                                                      : "material wave speed"));
   field("steps", std::to_string(s.steps));
   field("simulated_time", jsonNumber(s.time));
   field("wall_seconds", jsonNumber(s.wallSeconds));
@@ -92,6 +106,29 @@ void writeRunRecord(const std::filesystem::path& file, const SceneSetup<D>& setu
   field("damped", jsonNumber(s.energy.damped));
   field("pvd", jsonText(s.pvd.string()));
   field("energies", jsonText(s.energies.string()));
+  if (s.instability) {
+    // What the stability guard found (app/Guards.hpp).
+    const Instability& u = *s.instability;
+    auto vec = [](const std::vector<double>& v) {
+      std::string out = "[";
+      for (std::size_t a = 0; a < v.size(); ++a) {
+        if (a) out += ", ";
+        out += jsonNumber(v[a]);
+      }
+      return out + "]";
+    };
+    std::ostringstream o;
+    o << "{\"step\": " << u.step << ", \"time\": " << jsonNumber(u.time)
+      << ", \"quantity\": " << jsonText(u.quantity) << ", \"value\": " << jsonNumber(u.value)
+      << ", \"description\": " << jsonText(u.description)
+      << ", \"particle\": " << (u.particle >= 0 ? std::to_string(u.particle) : "null")
+      << ", \"reference_position\": " << vec(u.referencePosition)
+      << ", \"current_position\": " << vec(u.currentPosition)
+      << ", \"cause\": " << jsonText(u.cause) << ", \"last_good_step\": " << u.lastGoodStep
+      << ", \"last_good_frame\": " << jsonText(u.lastGoodFrame.string())
+      << ", \"failed_frame\": " << jsonText(u.failedFrame.string()) << "}";
+    field("instability", o.str());
+  }
   field("probes", jsonText(s.probes.string()), true);
   j << "}\n";
   writeAtomically(file, [&](const std::filesystem::path& tmp) {

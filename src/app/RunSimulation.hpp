@@ -7,11 +7,13 @@
 #include <filesystem>
 #include <iomanip>
 #include <memory>
+#include <optional>
 #include <ostream>
 #include <sstream>
 #include <string>
 
 #include "app/Frames.hpp"
+#include "app/Guards.hpp"
 #include "output/CsvSeries.hpp"
 #include "output/VtuSeriesWriter.hpp"
 #include "scene/SceneSetup.hpp"
@@ -32,11 +34,13 @@ struct RunSummary {
   long steps = 0;
   double time = 0.0;
   double timeStep = 0.0;
+  StableStep stableStep;  // the wave-speed rule's step and what sets it
   double wallSeconds = 0.0;
   double residual = 0.0;
   EnergyBalance energy;
   std::filesystem::path pvd, energies, probes;
   std::string message;
+  std::optional<Instability> instability;  // set when the outcome is Unstable
 };
 
 template <int D>
@@ -120,8 +124,10 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
 
   RunSummary summary;
   summary.timeStep = solver.timeStep();
+  summary.stableStep = solver.stableStepRule();
   recordSeries();
   writeFrame();
+  RunGuard<D> guard(setup, solver);  // the stability guards (Guards.hpp)
   double nextFrameTime = out.everyTime;
   auto lastProgress = Clock::now();
   const double endTime = run.endTime * (1.0 - 1e-12);
@@ -139,7 +145,8 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
     solver.step();
     const long step = solver.stepCount();
     if (step % run.checkEvery == 0) {
-      if (!stateIsFinite(p)) {
+      summary.instability = guard.check();
+      if (summary.instability) {
         summary.outcome = RunOutcome::Unstable;
         break;
       }
@@ -180,11 +187,13 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
   if (summary.outcome != RunOutcome::Unstable) {
     recordSeries();
     writeFrame();
+    summary.energy = solver.energyBalance();
   } else {
     energies.flush();
     if (probes) probes->flush();
+    summary.energy = solver.energyBalance();  // the failing state's books
+    guard.writeFrames(*summary.instability);  // leaves the solver in the last good state
   }
-  summary.energy = solver.energyBalance();
   summary.wallSeconds = std::chrono::duration<double>(Clock::now() - start).count();
   if (vtu) summary.pvd = vtu->pvdPath();
   summary.energies = dir / "energies.csv";

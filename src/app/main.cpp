@@ -44,7 +44,9 @@ run options:
                                and CI is not set)
 
 exit status: 0 finished (or a static run converged), 1 bad input or set-up, 3 a static
-run did not converge, 4 the run went unstable.
+run did not converge, 4 the run went unstable (a [guard] check failed: the message names
+step, particle, quantity and likely cause; NAME_last_good.vtu and NAME_failed.vtu are
+written).
 )";
 
 using namespace tlsph;
@@ -66,7 +68,17 @@ void printSetup(const SceneSetup<D>& setup, const Solver<D>& solver) {
             << " m = " << setup.scene.supportRadius / setup.dx << " dx, "
             << gradientCorrectionName(setup.scene.gradientCorrection) << " gradient correction)\n"
             << "hourglass    alpha = " << setup.scene.hourglassCoefficient
-            << (setup.scene.hourglassCoefficient == 0 ? " (off)" : "") << "\n";
+            << (setup.scene.hourglassCoefficient == 0
+                    ? std::string(" (off)")
+                    : std::string(", form ") + hourglassFormName(setup.scene.hourglassForm) +
+                          (setup.scene.hourglassForm == HourglassForm::Energy
+                               ? std::string(", on the ") +
+                                     hourglassGradientName(setup.scene.hourglassGradient) + " F"
+                               : std::string()))
+            << "\n";
+  if (setup.scene.viscosity.enabled())
+    std::cout << "viscosity    artificial (6.77): linear q1 = " << setup.scene.viscosity.linear
+              << ", quadratic q2 = " << setup.scene.viscosity.quadratic << "\n";
   for (std::size_t m = 0; m < setup.scene.materials.size(); ++m) {
     const auto& mat = setup.scene.materials[m];
     const auto& c = elasticConstants(mat);
@@ -92,6 +104,23 @@ void printSetup(const SceneSetup<D>& setup, const Solver<D>& solver) {
                     ? ", static: stop when residual < " + std::to_string(setup.run.tolerance)
                     : std::string())
             << "\n";
+  {
+    // What sets the step: dt = C_cfl dx / sqrt(c^2 + c_hg^2) at the limiting particle.
+    const StableStep& rule = solver.stableStepRule();
+    const Vec<D> X = p.referencePosition[rule.particle];
+    std::cout << "time step    "
+              << (setup.solver.timeStep > 0.0 ? "[time] dt given; the rule gives " : "rule: ")
+              << rule.dt << " s = CFL x dx / c_eff at particle " << rule.particle << " ("
+              << X.transpose() << "): dx = " << rule.dx
+              << " m, material wave speed c = " << rule.waveSpeed << " m/s";
+    if (rule.hourglassSpeed > 0.0)
+      std::cout << ", hourglass springs add c_hg = " << rule.hourglassSpeed
+                << " m/s (c_eff = " << rule.hourglassFactor() << " c)";
+    std::cout << "; limited by the "
+              << (rule.hourglassSpeed > rule.waveSpeed ? "hourglass penalty"
+                                                       : "material wave speed")
+              << "\n";
+  }
   std::cout << "output       " << setup.output.directory << "/";
   if (setup.output.fields.empty()) {
     std::cout << " (CSV only)\n";
@@ -136,6 +165,11 @@ int runOrCheck(const Config& config, bool run, bool progress, const std::string&
   if (!s.pvd.empty()) std::cout << "wrote        " << s.pvd.string() << "\n";
   std::cout << "wrote        " << s.energies.string() << "\n";
   if (!s.probes.empty()) std::cout << "wrote        " << s.probes.string() << "\n";
+  if (s.instability) {
+    std::cout << "wrote        " << s.instability->failedFrame.string() << "\n"
+              << "wrote        " << s.instability->lastGoodFrame.string() << " (step "
+              << s.instability->lastGoodStep << ", t = " << s.instability->lastGoodTime << " s)\n";
+  }
   std::cout << "wrote        " << record.string() << "\n";
   if (!s.message.empty()) std::cout << s.message << "\n";
   switch (s.outcome) {
@@ -149,10 +183,19 @@ int runOrCheck(const Config& config, bool run, bool progress, const std::string&
       std::cout << "NOT converged: residual " << s.residual << " >= " << setup.run.tolerance
                 << " at the end time; raise [time] end or the damping\n";
       return 3;
-    case RunOutcome::Unstable:
-      std::cerr << "tlsph: the run went unstable (non-finite state) near step " << s.steps
-                << ", t = " << s.time << " s; reduce [time] cfl or check the loads\n";
+    case RunOutcome::Unstable: {
+      // tlsph: unstable at step N, t = T s: <quantity and value> at particle I (X = ...):
+      //   likely <cause>
+      std::cout.flush();
+      const Instability& u = *s.instability;
+      std::cerr << "tlsph: unstable at step " << u.step << ", t = " << u.time
+                << " s: " << u.description;
+      if (u.particle >= 0)
+        std::cerr << " at particle " << u.particle
+                  << " (X = " << guard_detail::vectorText(u.referencePosition) << ")";
+      std::cerr << ":\n  " << u.cause << "\n";
       return 4;
+    }
   }
   return 0;
 }

@@ -1,7 +1,9 @@
 #include "scene/SceneBuilder.hpp"
 
+#include <array>
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <numbers>
 #include <set>
 #include <stdexcept>
@@ -30,6 +32,35 @@ std::string fmt(const Vec<D>& v) {
   std::ostringstream s;
   s << "(" << v.transpose() << ")";
   return s.str();
+}
+
+// The `axis` of a rotation, normalised: required in 3D; in 2D the rotation is about z, so the
+// key may be left out or must be along z (-z reverses the sense).
+template <int D>
+Vec3 rotationAxis(SectionReader& r) {
+  if constexpr (D == 2) {
+    if (!r.has("axis")) return Vec3::UnitZ();
+    const auto v = r.numbers("axis");
+    const Vec3 a = v.size() == 3 ? Vec3(v[0], v[1], v[2]) : Vec3::Zero();
+    if (a.isZero() || a.head<2>().norm() > 1e-12 * a.norm())
+      throw r.error("axis", "a 2D rotation is about z: give 0 0 1 or 0 0 -1, or leave the key out");
+    return a.z() > 0 ? Vec3::UnitZ() : Vec3(-Vec3::UnitZ());
+  } else {
+    const Vec3 a = r.vector<3>("axis");
+    if (!(a.norm() > 0.0)) throw r.error("axis", "must not be zero");
+    return a.normalized();
+  }
+}
+
+template <int D>
+std::string rotationText(const Vec3& axis, const Vec<D>& point, double rate) {
+  std::string s = "rate " + fmt(rate) + " rad/s about ";
+  if constexpr (D == 2) {
+    s += axis.z() > 0 ? "z" : "-z";
+  } else {
+    s += "axis " + fmt<3>(axis);
+  }
+  return s + " through " + fmt<D>(point);
 }
 
 template <int D>
@@ -96,6 +127,7 @@ class Builder {
     readInitialConditions();
     readTimeAndDamping();
     readOutput();
+    readGuard();
     readProbes();
     return std::move(setup_);
   }
@@ -169,7 +201,15 @@ class Builder {
     k.finish();
     SectionReader h(config_, "hourglass");
     setup_.scene.hourglassCoefficient = h.nonNegative("alpha", 10.0);
+    setup_.scene.hourglassForm =
+        parseHourglassForm(h.word("form", "energy", {"energy", "ganzenmueller"}));
+    setup_.scene.hourglassGradient =
+        parseHourglassGradient(h.word("gradient", "corrected", {"corrected", "linear"}));
     h.finish();
+    SectionReader v(config_, "artificial_viscosity");
+    setup_.scene.viscosity.linear = v.nonNegative("linear", 0.0);
+    setup_.scene.viscosity.quadratic = v.nonNegative("quadratic", 0.0);
+    v.finish();
   }
 
   void fillBodies() {
@@ -252,6 +292,21 @@ class Builder {
     return setup_.regions.at(name);
   }
 
+  // The body particle at lattice point X (-1 if none): body particles sit at cell centres.
+  Index latticeParticle(const Vec<D>& X) {
+    auto key = [&](const Vec<D>& x) {
+      std::array<long, D> k;
+      for (int a = 0; a < D; ++a)
+        k[a] = std::lround(2.0 * x[a] / setup_.dx);
+      return k;
+    };
+    if (latticeIndex_.empty())
+      for (Index i = 0; i < bodyCount_; ++i)
+        latticeIndex_[key(setup_.scene.particles.referencePosition[i])] = i;
+    const auto it = latticeIndex_.find(key(X));
+    return it == latticeIndex_.end() ? -1 : it->second;
+  }
+
   void addClamps() {
     const int layersNeeded = static_cast<int>(std::ceil(supportRatio_ - 1e-9));
     auto& p = setup_.scene.particles;
@@ -267,6 +322,7 @@ class Builder {
       const std::string face = r.word("face", std::nullopt, faces);
       if (!facesUsed.insert(face).second)
         throw r.error("face", "face " + face + " is clamped twice");
+      const std::string method = r.word("method", "mirror", {"mirror", "fixed"});
       const long layers = r.integer("layers", layersNeeded);
       if (layers < layersNeeded)
         throw r.error("layers", std::to_string(layers) +
@@ -278,25 +334,44 @@ class Builder {
       const int axis = face[0] - 'x';
       const double sign = face[1] == '-' ? -1.0 : 1.0;
       const double edge = sign < 0 ? box.min()[axis] : box.max()[axis];
+      const bool mirror = method == "mirror";
       Prescription<D> clamp;
       clamp.name = "clamp." + name;
       const double V = std::pow(setup_.dx, D);
+      Index ghosts = 0;
       for (Index i = 0; i < bodyCount_; ++i) {
         if (std::abs(X[i][axis] - edge) > 0.25 * setup_.dx) continue;
         for (long k = 1; k <= layers; ++k) {
           Vec<D> G = X[i];
           G[axis] += sign * k * setup_.dx;
+          Index image = -1;
+          if (mirror) {
+            // ghost layer k mirrors body layer k across the face, half a spacing outside X_i
+            Vec<D> M = X[i];
+            M[axis] -= sign * (k - 1) * setup_.dx;
+            image = latticeParticle(M);
+            if (image < 0)
+              throw r.error("method", "the body is thinner than " + std::to_string(layers) +
+                                          " layers behind face " + face + " at (" + fmt<D>(M) +
+                                          "): a mirrored clamp needs a body particle there; "
+                                          "use method = fixed");
+          }
           const std::uint16_t m = p.material[i];
-          clamp.particles.push_back(
-              p.add(G, V, density(setup_.scene.materials[m]) * V, m, Motion::Prescribed));
+          const Index g = p.add(G, V, density(setup_.scene.materials[m]) * V, m,
+                                mirror ? Motion::Mirrored : Motion::Prescribed);
+          if (mirror)
+            setup_.scene.mirrorGhosts.push_back({g, image});
+          else
+            clamp.particles.push_back(g);
           setup_.body.push_back(setup_.body[i]);
           setup_.ghost.push_back(1);
+          ++ghosts;
         }
       }
-      setup_.conditions.push_back("clamp." + name + ": face " + face + ", " +
+      setup_.conditions.push_back("clamp." + name + ": face " + face + ", " + method + ", " +
                                   std::to_string(layers) + " ghost layers, " +
-                                  std::to_string(clamp.particles.size()) + " ghost particles");
-      setup_.scene.prescriptions.push_back(std::move(clamp));
+                                  std::to_string(ghosts) + " ghost particles");
+      if (!mirror) setup_.scene.prescriptions.push_back(std::move(clamp));
     }
   }
 
@@ -307,13 +382,22 @@ class Builder {
       Prescription<D> rule;
       rule.name = "prescribe." + name;
       rule.particles = region(r);
-      const std::string motion = r.word("motion", "fixed", {"fixed", "velocity", "displacement"});
-      rule.motion = motion == "fixed"      ? PrescribedMotion::Fixed
-                    : motion == "velocity" ? PrescribedMotion::Velocity
-                                           : PrescribedMotion::Displacement;
-      if (rule.motion != PrescribedMotion::Fixed) rule.value = r.vector<D>("value");
+      const std::string motion =
+          r.word("motion", "fixed", {"fixed", "velocity", "displacement", "rotation"});
+      rule.motion = motion == "fixed"          ? PrescribedMotion::Fixed
+                    : motion == "velocity"     ? PrescribedMotion::Velocity
+                    : motion == "displacement" ? PrescribedMotion::Displacement
+                                               : PrescribedMotion::Rotation;
+      if (rule.motion == PrescribedMotion::Rotation) {
+        // Rigid rotation about the axis through `point` at `rate` rad/s (times the ramp).
+        rule.axis = rotationAxis<D>(r);
+        rule.point = r.vector<D>("point");
+        rule.rate = r.number("rate");
+      } else if (rule.motion != PrescribedMotion::Fixed) {
+        rule.value = r.vector<D>("value");
+      }
       rule.ramp.duration = r.nonNegative("ramp", 0.0);
-      r.allow({"value"});
+      if (rule.motion != PrescribedMotion::Rotation) r.allow({"value"});
       r.finish();
       for (Index i : rule.particles) {
         if (p.motion[i] == Motion::Prescribed)
@@ -322,10 +406,12 @@ class Builder {
                                       " is already prescribed by another condition");
         p.motion[i] = Motion::Prescribed;
       }
-      setup_.conditions.push_back(
-          rule.name + ": " + motion + " " +
-          (rule.motion == PrescribedMotion::Fixed ? "" : fmt<D>(rule.value)) + " on " +
-          std::to_string(rule.particles.size()) + " particles");
+      const std::string what = rule.motion == PrescribedMotion::Fixed ? ""
+                               : rule.motion == PrescribedMotion::Rotation
+                                   ? rotationText<D>(rule.axis, rule.point, rule.rate) + " "
+                                   : fmt<D>(rule.value) + " ";
+      setup_.conditions.push_back(rule.name + ": " + motion + " " + what + "on " +
+                                  std::to_string(rule.particles.size()) + " particles");
       setup_.scene.prescriptions.push_back(std::move(rule));
     }
   }
@@ -367,12 +453,22 @@ class Builder {
     for (const auto& name : config_.namesOf("initial")) {
       SectionReader r(config_, "initial." + name);
       const auto& particles = region(r);
-      const std::string profile = r.word("profile", "constant", {"constant", "beam-mode"});
+      const std::string profile =
+          r.word("profile", "constant", {"constant", "beam-mode", "rotation"});
       if (profile == "constant") {
         const Vec<D> v = r.vector<D>("velocity");
         for (Index i : particles)
           p.velocity[i] = v;
         setup_.conditions.push_back("initial." + name + ": velocity " + fmt<D>(v));
+      } else if (profile == "rotation") {
+        // A rigid spin: v = rate axis x (X - point).
+        const Vec3 axis = rotationAxis<D>(r);
+        const Vec<D> point = r.vector<D>("point");
+        const double rate = r.number("rate");
+        for (Index i : particles)
+          p.velocity[i] = rotationVelocity<D>(axis, rate, Vec<D>(p.referencePosition[i] - point));
+        setup_.conditions.push_back("initial." + name + ": rotation " +
+                                    rotationText<D>(axis, point, rate));
       } else {
         // First cantilever mode shape (DESIGN.md section 6, oscillating plate):
         // v(s) = amplitude f(s)/f(L) along `direction`, s the distance from `origin` along `axis`.
@@ -406,7 +502,7 @@ class Builder {
                                     " m/s");
       }
       r.allow({"velocity", "amplitude", "amplitude_over_c0", "axis", "direction", "origin",
-               "length", "kL"});
+               "length", "kL", "point", "rate"});
       r.finish();
     }
   }
@@ -431,7 +527,7 @@ class Builder {
       if (!setup_.scene.damping.any())
         throw InputError(config_.origin(), "static", "enabled",
                          "a static run needs damping: set [damping] kinetic = true or viscous > 0");
-      if (setup_.scene.prescriptions.empty())
+      if (setup_.scene.prescriptions.empty() && setup_.scene.mirrorGhosts.empty())
         throw InputError(config_.origin(), "static", "enabled",
                          "a static run needs the body held: add a [clamp.NAME] or a "
                          "[prescribe.NAME] section, or it drifts away under its loads");
@@ -460,6 +556,17 @@ class Builder {
       setup_.output.everyTime = setup_.run.endTime / 20.0;
     setup_.output.seriesEverySteps = std::max(1L, o.integer("series_every_steps", 20));
     o.finish();
+  }
+
+  // The run's stability guards (RunSimulation.hpp), checked every [static] check_every steps.
+  void readGuard() {
+    SectionReader g(config_, "guard");
+    setup_.guard.minJacobian = g.number("min_jacobian", 0.0);
+    if (!(setup_.guard.minJacobian >= 0.0 && setup_.guard.minJacobian < 1.0))
+      throw g.error("min_jacobian",
+                    "must be in [0, 1), got " + config_.get("guard", "min_jacobian"));
+    setup_.guard.energyError = g.nonNegative("energy_error", 0.05);
+    g.finish();
   }
 
   void readProbes() {
@@ -512,9 +619,24 @@ class Builder {
   }
 
   void rejectUnknownSections() {
-    static const std::vector<std::string> kinds = {
-        "scene",    "kernel", "hourglass", "time",  "static",    "damping", "gravity", "output",
-        "material", "body",   "region",    "clamp", "prescribe", "load",    "initial", "probe"};
+    static const std::vector<std::string> kinds = {"scene",
+                                                   "kernel",
+                                                   "hourglass",
+                                                   "time",
+                                                   "static",
+                                                   "damping",
+                                                   "gravity",
+                                                   "output",
+                                                   "material",
+                                                   "body",
+                                                   "region",
+                                                   "clamp",
+                                                   "prescribe",
+                                                   "load",
+                                                   "initial",
+                                                   "probe",
+                                                   "artificial_viscosity",
+                                                   "guard"};
     for (const auto& section : config_.sections()) {
       const std::string kind = section.substr(0, section.find('.'));
       if (std::find(kinds.begin(), kinds.end(), kind) != kinds.end()) continue;
@@ -529,6 +651,7 @@ class Builder {
   std::size_t maxParticles_ = 0;
   double supportRatio_ = 2.0;
   Index bodyCount_ = 0;
+  std::map<std::array<long, D>, Index> latticeIndex_;  // lattice point -> body particle
 };
 
 }  // namespace

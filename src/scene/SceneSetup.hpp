@@ -27,6 +27,13 @@ struct OutputSettings {
   long seriesEverySteps = 0;        // energies/probes CSV row every N steps
 };
 
+// The run's stability guards ([guard]), evaluated every RunSettings::checkEvery steps.
+struct GuardSettings {
+  double minJacobian = 0.0;   // stop when det F <= this at a body particle
+  double energyError = 0.05;  // stop when the energy books drift by this fraction of their
+                              // scale, or the hourglass energy is that far below zero; 0: off
+};
+
 enum class ProbeMethod { Nearest, Kernel };
 
 template <int D>
@@ -50,6 +57,7 @@ struct SceneSetup {
   SolverSettings solver;
   RunSettings run;
   OutputSettings output;
+  GuardSettings guard;
   std::vector<Probe<D>> probes;
   std::vector<std::string> materialNames;  // by material index
   std::vector<std::string> bodyNames;      // by body index

@@ -1,6 +1,11 @@
 // Global quantities that tell whether a run is healthy: energies, momenta, finiteness.
 #pragma once
 
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
 #include "tlsph/Particles.hpp"
 #include "tlsph/Types.hpp"
 
@@ -62,6 +67,75 @@ bool stateIsFinite(const ParticleSet<D>& p) {
     finite = finite && p.displacement[i].allFinite() && p.velocity[i].allFinite() &&
              p.force[i].allFinite();
   return finite;
+}
+
+// What one pass over the particles finds for the run's stability guards.
+struct StateScan {
+  Index nonFinite = -1;  // lowest-index particle with a non-finite u, v or f; -1: none
+  const char* nonFiniteQuantity = "";  // "displacement", "velocity" or "force" (the first of them)
+  Index smallestJParticle = -1;        // body particle with the smallest finite J = det F
+  double smallestJ = std::numeric_limits<double>::infinity();
+  Index fastest = -1;  // particle with the largest finite speed
+  double largestSpeed = 0.0;
+};
+
+// One parallel pass: the first non-finite particle, the smallest J over the particles not
+// flagged in `skip` (clamp ghosts; empty: none skipped) and the largest speed. Ties go to the
+// lower index, so the result does not depend on the thread count.
+template <int D>
+StateScan scanState(const ParticleSet<D>& p, const std::vector<Mat<D>>& F,
+                    const std::vector<std::uint8_t>& skip) {
+  StateScan total;
+  const Index n = p.size();
+  auto merge = [](StateScan& into, const StateScan& s) {
+    if (s.nonFinite >= 0 && (into.nonFinite < 0 || s.nonFinite < into.nonFinite)) {
+      into.nonFinite = s.nonFinite;
+      into.nonFiniteQuantity = s.nonFiniteQuantity;
+    }
+    if (s.smallestJParticle >= 0 &&
+        (into.smallestJParticle < 0 || s.smallestJ < into.smallestJ ||
+         (s.smallestJ == into.smallestJ && s.smallestJParticle < into.smallestJParticle))) {
+      into.smallestJParticle = s.smallestJParticle;
+      into.smallestJ = s.smallestJ;
+    }
+    if (s.fastest >= 0 && (into.fastest < 0 || s.largestSpeed > into.largestSpeed ||
+                           (s.largestSpeed == into.largestSpeed && s.fastest < into.fastest))) {
+      into.fastest = s.fastest;
+      into.largestSpeed = s.largestSpeed;
+    }
+  };
+#pragma omp parallel
+  {
+    StateScan local;
+#pragma omp for schedule(static) nowait
+    for (Index i = 0; i < n; ++i) {
+      if (local.nonFinite < 0) {  // indices rise within a thread: the first found is its lowest
+        const char* bad = !p.displacement[i].allFinite() ? "displacement"
+                          : !p.velocity[i].allFinite()   ? "velocity"
+                          : !p.force[i].allFinite()      ? "force"
+                                                         : nullptr;
+        if (bad) {
+          local.nonFinite = i;
+          local.nonFiniteQuantity = bad;
+        }
+      }
+      if (skip.empty() || !skip[i]) {
+        const double J = F[i].determinant();
+        if (std::isfinite(J) && (local.smallestJParticle < 0 || J < local.smallestJ)) {
+          local.smallestJ = J;
+          local.smallestJParticle = i;
+        }
+      }
+      const double speed = p.velocity[i].norm();
+      if (std::isfinite(speed) && (local.fastest < 0 || speed > local.largestSpeed)) {
+        local.largestSpeed = speed;
+        local.fastest = i;
+      }
+    }
+#pragma omp critical(tlsph_scan_state)
+    merge(total, local);
+  }
+  return total;
 }
 
 }  // namespace tlsph

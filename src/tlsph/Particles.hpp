@@ -8,9 +8,10 @@
 
 namespace tlsph {
 
-// How a particle moves: by the integrator, or by a prescription (clamps, ghost layers,
-// driven boundaries). Prescribed particles take part in every neighbour sum.
-enum class Motion : std::uint8_t { Free, Prescribed };
+// How a particle moves: by the integrator, by a prescription (fixed clamps, driven
+// boundaries), or as the odd mirror image of a body particle (mirrored clamp ghosts: u = -u_M).
+// Prescribed and mirrored particles take part in every neighbour sum.
+enum class Motion : std::uint8_t { Free, Prescribed, Mirrored };
 
 template <int D>
 struct ParticleSet {

@@ -6,6 +6,7 @@
 #include "materials/Material.hpp"
 #include "tlsph/Conditions.hpp"
 #include "tlsph/Kernel.hpp"
+#include "tlsph/PairTerms.hpp"
 #include "tlsph/Particles.hpp"
 #include "tlsph/PeriodicBox.hpp"
 #include "tlsph/ReferenceConfiguration.hpp"
@@ -21,12 +22,20 @@ struct Scene {
   double supportRadius = 0.0;  // H = 2h
   GradientCorrection gradientCorrection = GradientCorrection::Linear;
   double hourglassCoefficient = 0.0;  // alpha of (6.80); 0: no hourglass pass at all
+  HourglassForm hourglassForm = HourglassForm::Energy;
+  HourglassGradient hourglassGradient = HourglassGradient::Corrected;
+  ViscositySettings viscosity;  // artificial viscosity (6.77); off by default
   PeriodicBox<D> periodicBox;
   Vec<D> gravity = Vec<D>::Zero();  // body force per unit mass
   Ramp gravityRamp;
   std::vector<Prescription<D>> prescriptions;  // their particles must have Motion::Prescribed
+  std::vector<MirrorGhost> mirrorGhosts;       // their ghosts must have Motion::Mirrored
   std::vector<Load<D>> loads;
   Damping damping;
+
+  HourglassSettings hourglass() const {
+    return {hourglassCoefficient, hourglassForm, hourglassGradient};
+  }
 };
 
 }  // namespace tlsph

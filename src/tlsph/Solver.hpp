@@ -25,11 +25,12 @@ struct SolverSettings {
 // taken out by damping.
 struct EnergyBalance {
   double kinetic = 0.0;
-  double strain = 0.0;        // sum_I V_I psi(F_I), all particles (ghost F depends on the body)
-  double hourglass = 0.0;     // work done against the hourglass force
+  double strain = 0.0;     // sum_I V_I psi(F_I): body and fixed ghosts (mirrored ghosts carry none)
+  double hourglass = 0.0;  // E_hg (energy form) or work done against the (6.80) force
+
   double externalWork = 0.0;  // work of body forces and loads on free particles
   double boundaryWork = 0.0;  // work of prescribed particles on the rest
-  double damped = 0.0;        // energy removed by viscous and kinetic damping
+  double damped = 0.0;  // energy removed by viscous and kinetic damping and artificial viscosity
   double total() const {
     return kinetic + strain + hourglass - externalWork - boundaryWork + damped;
   }
@@ -45,15 +46,24 @@ class Solver {
                                             scene.particles.volume, checkedKernel(scene),
                                             scene.periodicBox, scene.gradientCorrection)),
         forces_(ref_, scene.materials, scene.particles.material, scene.particles.volume,
-                scene.hourglassCoefficient) {
+                scene.hourglass(), scene.viscosity, 0.5 * scene.supportRadius,
+                mirrorGhostList(scene)) {
     if (!(settings.cfl > 0.0)) throw SetupError("the CFL number must be positive");
     const auto& p = scene.particles;
-    dt_ = settings.timeStep > 0.0 ? settings.timeStep
-                                  : stableTimeStep(p, scene.materials, settings.cfl);
+    std::vector<double> hourglassStiffness;
+    if (forces_.hourglassEnabled()) {
+      hourglassStiffness.resize(p.size());
+      for (Index i = 0; i < p.size(); ++i)
+        hourglassStiffness[i] = forces_.hourglassStiffness(i);
+    }
+    stable_ = stableStep(p, scene.materials, settings.cfl, hourglassStiffness);
+    dt_ = settings.timeStep > 0.0 ? settings.timeStep : stable_.dt;
     std::vector<int> slot(p.size(), -1);
     for (Index i = 0; i < p.size(); ++i) {
       if (p.motion[i] == Motion::Free) {
         free_.push_back(i);
+      } else if (p.motion[i] == Motion::Mirrored) {
+        continue;
       } else {
         slot[i] = static_cast<int>(prescribed_.size());
         prescribed_.push_back(i);
@@ -76,12 +86,17 @@ class Solver {
       external_.assign(p.size(), Vec<D>::Zero());
       computeExternalForces(0.0);
     }
-    forces_.compute(scene.particles.displacement, scene.particles.force);
+    mirrorGhostMotion();
+    forces_.compute(scene.particles.displacement, scene.particles.force, &scene.particles.velocity);
+    chainMirrorForces();
     previousKinetic_ = kineticEnergy(scene.particles);
   }
 
   double time() const { return time_; }
   double timeStep() const { return dt_; }
+  // The wave-speed rule's step at the run's C_cfl and what sets it (also when [time] dt
+  // overrides it).
+  const StableStep& stableStepRule() const { return stable_; }
   long stepCount() const { return steps_; }
   const ReferenceConfiguration<D>& reference() const { return ref_; }
   const TlsphForces<D>& forces() const { return forces_; }
@@ -95,7 +110,10 @@ class Solver {
     const double c = scene_.damping.viscous;
     const Index nFree = static_cast<Index>(free_.size());
     const Index nPrescribed = static_cast<Index>(prescribed_.size());
-    const bool hourglass = forces_.hourglassEnabled();
+    // Work is integrated for the non-conservative terms only: the textbook hourglass force
+    // and the artificial viscosity (booked as damping). The energy form's E_hg is a state.
+    const bool hourglass = !forces_.hourglassForce().empty();
+    const bool viscous = forces_.viscosityEnabled();
     double hourglassWork = 0.0, externalWork = 0.0, boundaryWork = 0.0, dampingWork = 0.0;
 
     // Kick and drift; each work term is integrated with the trapezoidal rule over the
@@ -109,6 +127,7 @@ class Solver {
       dampingWork += c * p.mass[i] * p.velocity[i].dot(du);
       if (hasExternal_) externalWork += 0.5 * external_[i].dot(du);
       if (hourglass) hourglassWork += 0.5 * forces_.hourglassForce()[i].dot(du);
+      if (viscous) dampingWork -= 0.5 * forces_.viscousForce()[i].dot(du);
     }
     for (Index k = 0; k < nPrescribed; ++k) {
       const Index i = prescribed_[k];
@@ -119,16 +138,21 @@ class Solver {
     }
 
     time_ += dt_;
-    forces_.compute(p.displacement, p.force);
+    mirrorGhostMotion();
+    // The artificial viscosity sees the mid-step velocities.
+    forces_.compute(p.displacement, p.force, &p.velocity);
+    chainMirrorForces();
     if (hasExternal_) computeExternalForces(time_);
 
     double kinetic = 0.0;
-#pragma omp parallel for reduction(+ : hourglassWork, externalWork, kinetic) schedule(static)
+#pragma omp parallel for reduction(+ : hourglassWork, externalWork, dampingWork, kinetic) \
+    schedule(static)
     for (Index k = 0; k < nFree; ++k) {
       const Index i = free_[k];
       const Vec<D> du = dt_ * p.velocity[i];  // still the mid-step velocity
       if (hasExternal_) externalWork += 0.5 * external_[i].dot(du);
       if (hourglass) hourglassWork += 0.5 * forces_.hourglassForce()[i].dot(du);
+      if (viscous) dampingWork -= 0.5 * forces_.viscousForce()[i].dot(du);
       // Viscous damping taken implicitly in the second kick: stable for any c.
       p.velocity[i] = (p.velocity[i] + halfDt * totalForce(i) / p.mass[i]) / (1.0 + c * halfDt);
       kinetic += 0.5 * p.mass[i] * p.velocity[i].squaredNorm();
@@ -150,6 +174,7 @@ class Solver {
       }
       previousKinetic_ = kinetic;
     }
+    mirrorGhostMotion();
 
     hourglassWorkDone_ += hourglassWork;
     externalWork_ += externalWork;
@@ -162,7 +187,9 @@ class Solver {
     EnergyBalance e;
     e.kinetic = kineticEnergy(scene_.particles);
     e.strain = forces_.strainEnergy();
-    e.hourglass = -hourglassWorkDone_;
+    e.hourglass = forces_.hourglassConservative()
+                      ? forces_.hourglassEnergy(scene_.particles.displacement)
+                      : -hourglassWorkDone_;
     e.externalWork = externalWork_;
     e.boundaryWork = boundaryWork_;
     e.damped = damped_;
@@ -197,7 +224,55 @@ class Solver {
     return end;
   }
 
+  // Recomputes the forces (and the external forces at the current time) for the particles'
+  // present displacements and velocities, without advancing: for a state put back from a
+  // copy, e.g. to write the last good frame of a run that went unstable.
+  void reevaluate() {
+    auto& p = scene_.particles;
+    mirrorGhostMotion();
+    forces_.compute(p.displacement, p.force, &p.velocity);
+    chainMirrorForces();
+    if (hasExternal_) computeExternalForces(time_);
+  }
+
  private:
+  static std::vector<Index> mirrorGhostList(const Scene<D>& scene) {
+    const auto& p = scene.particles;
+    std::vector<Index> ghosts;
+    std::vector<std::uint8_t> listed(p.size(), 0);
+    for (const auto& m : scene.mirrorGhosts) {
+      if (m.ghost < 0 || m.ghost >= p.size() || m.mirror < 0 || m.mirror >= p.size() ||
+          p.motion[m.ghost] != Motion::Mirrored || p.motion[m.mirror] != Motion::Free)
+        throw SetupError("mirror ghost " + std::to_string(m.ghost) + " of particle " +
+                         std::to_string(m.mirror) +
+                         " must be a mirrored particle whose mirror is a free one");
+      listed[m.ghost] = 1;
+      ghosts.push_back(m.ghost);
+    }
+    for (Index i = 0; i < p.size(); ++i)
+      if (p.motion[i] == Motion::Mirrored && !listed[i])
+        throw SetupError("particle " + std::to_string(i) + " is mirrored but has no mirror");
+    return ghosts;
+  }
+
+  // u_ghost = -u_mirror, v_ghost = -v_mirror: the odd reflection across the clamped face.
+  void mirrorGhostMotion() {
+    auto& p = scene_.particles;
+    for (const auto& m : scene_.mirrorGhosts) {
+      p.displacement[m.ghost] = -p.displacement[m.mirror];
+      p.velocity[m.ghost] = -p.velocity[m.mirror];
+    }
+  }
+
+  // The chain rule of u_ghost = -u_mirror: -dE/du_mirror gains -(-dE/du_ghost). The ghost
+  // keeps its own force as the clamp's reaction (for reports). Serial: two faces' ghosts can
+  // share a mirror particle.
+  void chainMirrorForces() {
+    auto& p = scene_.particles;
+    for (const auto& m : scene_.mirrorGhosts)
+      p.force[m.mirror] -= p.force[m.ghost];
+  }
+
   static Kernel<D> checkedKernel(const Scene<D>& scene) {
     if (scene.materials.empty()) throw SetupError("the scene has no material");
     if (scene.particles.size() == 0) throw SetupError("the scene has no particles");
@@ -234,6 +309,12 @@ class Solver {
         return p.displacement[i] + dt_ * rule.value * rule.ramp.factor(t - 0.5 * dt_);
       case PrescribedMotion::Displacement:
         return start_[k] + rule.value * rule.ramp.factor(t);
+      case PrescribedMotion::Rotation: {
+        // Exact at every step: x = point + R(theta(t)) (x_start - point), u = x - X.
+        const Vec<D>& X = p.referencePosition[i];
+        const Mat<D> R = rotationMatrix<D>(rule.axis, rampedAngle(rule.rate, rule.ramp, t));
+        return Vec<D>(rule.point + R * (X + start_[k] - rule.point) - X);
+      }
     }
     return p.displacement[i];
   }
@@ -249,6 +330,11 @@ class Solver {
         return rule.value * rule.ramp.factor(t);
       case PrescribedMotion::Displacement:
         return rule.value * rule.ramp.rate(t);
+      case PrescribedMotion::Rotation: {
+        const Index i = prescribed_[k];
+        const Vec<D> r = p.referencePosition[i] + p.displacement[i] - rule.point;
+        return rotationVelocity<D>(rule.axis, rule.rate * rule.ramp.factor(t), r);
+      }
     }
     return Vec<D>::Zero();
   }
@@ -262,6 +348,7 @@ class Solver {
   std::vector<Vec<D>> step_;   // per prescribed particle: its displacement over this step
   std::vector<Vec<D>> external_;
   bool hasExternal_ = false;
+  StableStep stable_;
   double dt_ = 0.0;
   double time_ = 0.0;
   long steps_ = 0;

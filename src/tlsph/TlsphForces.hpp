@@ -1,18 +1,27 @@
 // The per-step pair loops of total-Lagrangian SPH, read against DESIGN.md section 2:
 //   displacements u -> deformation gradients F (6.69) -> stresses P
-//   -> internal force (6.70) + Ganzenmueller hourglass force (6.80, 6.81).
+//   [-> hourglass stress and spring (EnergyHourglass)] -> internal force (6.70)
+//   [+ textbook hourglass pair force (6.80, 6.81)] [+ artificial viscosity (6.77)].
 // The corrected gradient vectors g_IJ (ReferenceConfiguration) carry L^{-1}: with them
 // F_I = 1 + sum_J (u_J - u_I) (x) g_IJ and f_I = -dE/du_I = V_I (P_I G_I - sum_J P_J t_IJ),
 // which for the linear correction is (6.70): V_I sum_J V_J (B_I + B_J) gradW_IJ, B = P L^{-T}.
-// Everything that depends only on the reference configuration is precomputed, so the
-// loops carry no branch on options: the hourglass term is a template parameter.
+// Each auxiliary term is its own operator (EnergyHourglass, GanzenmuellerHourglass,
+// ArtificialViscosity); the force pass is instantiated for the terms the scene uses, so a
+// term that is off is not computed and the loops carry no branch on options.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
+#include <memory>
 #include <variant>
 #include <vector>
 
 #include "materials/Material.hpp"
+#include "tlsph/ArtificialViscosity.hpp"
+#include "tlsph/EnergyHourglass.hpp"
+#include "tlsph/GanzenmuellerHourglass.hpp"
+#include "tlsph/HourglassStiffness.hpp"
+#include "tlsph/PairTerms.hpp"
 #include "tlsph/ReferenceConfiguration.hpp"
 #include "tlsph/Types.hpp"
 
@@ -21,62 +30,103 @@ namespace tlsph {
 template <int D>
 class TlsphForces {
  public:
-  // hourglassCoefficient is alpha of (6.80), dimensionless; 0 switches the term off entirely.
   TlsphForces(const ReferenceConfiguration<D>& reference, const std::vector<Material>& materials,
               const std::vector<std::uint16_t>& materialOfParticle,
-              const std::vector<double>& volume, double hourglassCoefficient)
+              const std::vector<double>& volume, const HourglassSettings& hourglass,
+              const ViscositySettings& viscosity = {}, double smoothingLength = 0.0,
+              const std::vector<Index>& passive = {})
       : ref_(reference),
         materials_(materials),
-        materialOfParticle_(materialOfParticle),
         volume_(volume),
-        alpha_(hourglassCoefficient),
+        hourglass_(hourglass),
         F_(reference.particleCount(), Mat<D>::Identity()),
         P_(reference.particleCount(), Mat<D>::Zero()) {
     const Index n = reference.particleCount();
     particlesOfMaterial_.resize(materials.size());
+    // Passive particles (mirrored ghosts) get an F but no stress and no strain energy.
+    std::vector<std::uint8_t> isPassive;
+    if (!passive.empty()) {
+      isPassive.assign(n, 0);
+      for (Index i : passive)
+        isPassive.at(i) = 1;
+    }
     for (Index i = 0; i < n; ++i)
-      particlesOfMaterial_.at(materialOfParticle[i]).push_back(i);
-    separateHourglassGradient_ = alpha_ != 0.0 && !reference.linearGradient.empty();
-    if (separateHourglassGradient_) hourglassF_.assign(n, Mat<D>::Identity());
-    if (alpha_ != 0.0) {
-      // c_IJ = alpha (E_I + E_J)/2 V_J W_IJ / |X_IJ|^2: symmetric in I, J, so the pair
-      // forces stay antisymmetric across material interfaces.
-      hourglassForce_.assign(n, Vec<D>::Zero());
-      hourglassStiffness_.resize(reference.neighbours.pairCount());
-      const auto& nb = reference.neighbours;
-      for (Index i = 0; i < n; ++i) {
-        const double Ei = elasticConstants(materials[materialOfParticle[i]]).youngsModulus;
-        for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
-          const Index j = nb.neighbour[k];
-          const double Ej = elasticConstants(materials[materialOfParticle[j]]).youngsModulus;
-          hourglassStiffness_[k] = alpha_ * 0.5 * (Ei + Ej) * volume[j] * reference.kernelValue[k] /
-                                   reference.separation[k].squaredNorm();
-        }
+      if (isPassive.empty() || !isPassive[i])
+        particlesOfMaterial_.at(materialOfParticle[i]).push_back(i);
+    passive_ = passive;
+    if (hourglass.enabled()) {
+      auto c = hourglassPairCoefficients(reference, materials, materialOfParticle, volume,
+                                         hourglass.alpha, isPassive);
+      // The textbook form always compares with the linear F; the energy form with the one
+      // chosen. With the linear correction there is only one F.
+      const bool linearF = hourglass.form == HourglassForm::Ganzenmueller ||
+                           hourglass.gradient == HourglassGradient::Linear;
+      separateHourglassGradient_ = linearF && !reference.linearGradient.empty();
+      if (separateHourglassGradient_) hourglassF_.assign(n, Mat<D>::Identity());
+      if (hourglass.form == HourglassForm::Energy) {
+        energyHourglass_ = std::make_unique<EnergyHourglass<D>>(reference, std::move(c), volume);
+        stress_.assign(n, Mat<D>::Zero());
+        if (separateHourglassGradient_) linearReverseGradients(volume);
+      } else {
+        ganzenmueller_ = std::make_unique<GanzenmuellerHourglass<D>>(std::move(c));
+        hourglassForce_.assign(n, Vec<D>::Zero());
       }
+    }
+    if (viscosity.enabled()) {
+      viscosity_ = std::make_unique<ArtificialViscosity<D>>(
+          reference, materials, materialOfParticle, smoothingLength, viscosity);
+      viscousForce_.assign(n, Vec<D>::Zero());
     }
   }
 
-  bool hourglassEnabled() const { return alpha_ != 0.0; }
-  double hourglassCoefficient() const { return alpha_; }
+  // The textbook penalty alone (tests and benchmarks of the chapter's form).
+  TlsphForces(const ReferenceConfiguration<D>& reference, const std::vector<Material>& materials,
+              const std::vector<std::uint16_t>& materialOfParticle,
+              const std::vector<double>& volume, double alpha)
+      : TlsphForces(reference, materials, materialOfParticle, volume,
+                    HourglassSettings{alpha, HourglassForm::Ganzenmueller}) {}
 
-  // Overwrites f with the internal plus hourglass force on every particle (ghosts included:
-  // on a prescribed particle it is the reaction).
-  void compute(const std::vector<Vec<D>>& u, std::vector<Vec<D>>& f) {
+  bool hourglassEnabled() const { return hourglass_.enabled(); }
+  double hourglassCoefficient() const { return hourglass_.alpha; }
+  const HourglassSettings& hourglass() const { return hourglass_; }
+  // True when the hourglass force is a state function's gradient (its energy is booked
+  // directly); false for the textbook form, whose work the solver integrates.
+  bool hourglassConservative() const { return energyHourglass_ != nullptr; }
+  bool viscosityEnabled() const { return viscosity_ != nullptr; }
+
+  // Overwrites f with the internal plus hourglass (plus viscous) force on every particle,
+  // ghosts included (on a prescribed particle it is the reaction). v is needed only with
+  // artificial viscosity.
+  void compute(const std::vector<Vec<D>>& u, std::vector<Vec<D>>& f,
+               const std::vector<Vec<D>>* v = nullptr) {
     for (std::size_t m = 0; m < materials_.size(); ++m)
       std::visit(
           [&](const auto& model) { deformationAndStress(model, particlesOfMaterial_[m], u); },
           materials_[m]);
-    if (hourglassEnabled())
-      accumulateForces<true>(u, f);
+    if (!passive_.empty()) passiveDeformation(u);
+    const bool viscous = viscosity_ && v != nullptr;
+    if (energyHourglass_ && separateHourglassGradient_) {
+      // P^hg of the linear F goes through the linear gradient vectors: its own sum.
+      energyHourglass_->evaluate(u, hourglassF_, nullptr, stress_);
+      viscous ? accumulateForces<false, true, true>(u, f, v)
+              : accumulateForces<false, false, true>(u, f, v);
+      return;
+    }
+    if (energyHourglass_) energyHourglass_->evaluate(u, F_, &P_, stress_);
+    if (ganzenmueller_)
+      viscous ? accumulateForces<true, true>(u, f, v) : accumulateForces<true, false>(u, f, v);
     else
-      accumulateForces<false>(u, f);
+      viscous ? accumulateForces<false, true>(u, f, v) : accumulateForces<false, false>(u, f, v);
   }
 
   const std::vector<Mat<D>>& deformationGradient() const { return F_; }
-  // Hourglass part of the last computed force (empty when the term is off).
+  // The textbook hourglass part of the last computed force (empty for the energy form and
+  // when the term is off); the solver integrates its work.
   const std::vector<Vec<D>>& hourglassForce() const { return hourglassForce_; }
+  // The artificial-viscosity part of the last computed force (empty when off).
+  const std::vector<Vec<D>>& viscousForce() const { return viscousForce_; }
 
-  // First Piola-Kirchhoff stress of particle i at the last computed F.
+  // First Piola-Kirchhoff stress of particle i at the last computed F (material only).
   Mat<D> firstPiola(Index i) const { return P_[i]; }
 
   // E = sum_I V_I psi(F_I) at the last computed F: the discrete strain energy whose negative
@@ -99,14 +149,31 @@ class TlsphForces {
     return total;
   }
 
+  // E_hg of the energy form for the displacements u of the last compute() (0 otherwise).
+  double hourglassEnergy(const std::vector<Vec<D>>& u) const {
+    return energyHourglass_
+               ? energyHourglass_->energy(u, separateHourglassGradient_ ? hourglassF_ : F_)
+               : 0.0;
+  }
+
+  // sum_J k_IJ = V_I sum_J c_IJ: the penalty's spring stiffness at particle i (0 when off).
+  double hourglassStiffness(Index i) const {
+    if (!hourglass_.enabled()) return 0.0;
+    if (energyHourglass_) return energyHourglass_->particleStiffness(i);
+    double sum = 0.0;
+    for (Index k = ref_.neighbours.offset[i]; k < ref_.neighbours.offset[i + 1]; ++k)
+      sum += ganzenmueller_->pairCoefficient(k);
+    return volume_[i] * sum;
+  }
+
  private:
   template <class Model>
   void deformationAndStress(const Model& model, const std::vector<Index>& group,
                             const std::vector<Vec<D>>& u) {
+    const auto& nb = ref_.neighbours;
+    const Index count = static_cast<Index>(group.size());
     if (separateHourglassGradient_) {
       // The penalty's own (linear-corrected) deformation gradient.
-      const auto& nb = ref_.neighbours;
-      const Index count = static_cast<Index>(group.size());
 #pragma omp parallel for schedule(static)
       for (Index p = 0; p < count; ++p) {
         const Index i = group[p];
@@ -116,8 +183,6 @@ class TlsphForces {
         hourglassF_[i] = Mat<D>::Identity() + gradU;
       }
     }
-    const auto& nb = ref_.neighbours;
-    const Index count = static_cast<Index>(group.size());
 #pragma omp parallel for schedule(static)
     for (Index p = 0; p < count; ++p) {
       const Index i = group[p];
@@ -131,50 +196,101 @@ class TlsphForces {
     }
   }
 
-  template <bool Hourglass>
-  void accumulateForces(const std::vector<Vec<D>>& u, std::vector<Vec<D>>& f) {
+  // F of the passive particles (the hourglass penalty and the output use it); P stays zero.
+  void passiveDeformation(const std::vector<Vec<D>>& u) {
+    const auto& nb = ref_.neighbours;
+    const Index count = static_cast<Index>(passive_.size());
+#pragma omp parallel for schedule(static)
+    for (Index p = 0; p < count; ++p) {
+      const Index i = passive_[p];
+      Mat<D> gradU = Mat<D>::Zero(), gradUlin = Mat<D>::Zero();
+      for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
+        gradU.noalias() += (u[nb.neighbour[k]] - u[i]) * ref_.correctedGradient[k].transpose();
+        if (separateHourglassGradient_)
+          gradUlin.noalias() += (u[nb.neighbour[k]] - u[i]) * ref_.linearGradient[k].transpose();
+      }
+      F_[i] = Mat<D>::Identity() + gradU;
+      if (separateHourglassGradient_) hourglassF_[i] = Mat<D>::Identity() + gradUlin;
+    }
+  }
+
+  // t^lin_IJ = (V_J / V_I) g^lin_JI and G^lin_I, for the energy penalty on the linear F when
+  // the stress uses the quadratic correction.
+  void linearReverseGradients(const std::vector<double>& volume) {
     const auto& nb = ref_.neighbours;
     const Index n = ref_.particleCount();
-#pragma omp parallel for schedule(static)
-    for (Index i = 0; i < n; ++i) {
-      // (6.70) as a force: f_I = V_I (P_I G_I - sum_J P_J t_IJ)
-      Vec<D> internal = P_[i] * ref_.correctedGradientSum[i];
-      Vec<D> hourglass = Vec<D>::Zero();
-      const Vec<D> ui = u[i];
-      const std::vector<Mat<D>>& Fh = separateHourglassGradient_ ? hourglassF_ : F_;
-      const Mat<D> Fi = Fh[i];
+    linearReverse_.resize(nb.pairCount());
+    linearSum_.assign(n, Vec<D>::Zero());
+    for (Index i = 0; i < n; ++i)
       for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
         const Index j = nb.neighbour[k];
-        internal.noalias() -= P_[j] * ref_.reverseGradient[k];
-        if constexpr (Hourglass) {
+        const auto first = nb.neighbour.begin() + nb.offset[j];
+        const auto at = std::lower_bound(first, nb.neighbour.begin() + nb.offset[j + 1], i);
+        const Index back = static_cast<Index>(at - nb.neighbour.begin());
+        linearReverse_[k] = (volume[j] / volume[i]) * ref_.linearGradient[back];
+        linearSum_[i] += ref_.linearGradient[k];
+      }
+  }
+
+  template <bool Ganzenmueller, bool Viscous, bool SeparateHourglassStress = false>
+  void accumulateForces(const std::vector<Vec<D>>& u, std::vector<Vec<D>>& f,
+                        const std::vector<Vec<D>>* velocity) {
+    const auto& nb = ref_.neighbours;
+    const Index n = ref_.particleCount();
+    // The stress the force pass sends through the gradient vectors: P, or P + P^hg (or P,
+    // and P^hg through the linear vectors).
+    const std::vector<Mat<D>>& S = energyHourglass_ && !SeparateHourglassStress ? stress_ : P_;
+    const std::vector<Mat<D>>& Fh = separateHourglassGradient_ ? hourglassF_ : F_;
+#pragma omp parallel for schedule(static)
+    for (Index i = 0; i < n; ++i) {
+      // (6.70) as a force: f_I = V_I (S_I G_I - sum_J S_J t_IJ)
+      Vec<D> internal = S[i] * ref_.correctedGradientSum[i];
+      Vec<D> hourglass = Vec<D>::Zero(), viscous = Vec<D>::Zero();
+      const Vec<D> ui = u[i];
+      if constexpr (SeparateHourglassStress) internal += stress_[i] * linearSum_[i];
+      for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
+        const Index j = nb.neighbour[k];
+        internal.noalias() -= S[j] * ref_.reverseGradient[k];
+        if constexpr (SeparateHourglassStress) internal.noalias() -= stress_[j] * linearReverse_[k];
+        if constexpr (Ganzenmueller || Viscous) {
           const Vec<D>& Xij = ref_.separation[k];
           const Vec<D> xij = Xij + (ui - u[j]);
-          const Vec<D> error = xij - 0.5 * ((Fi + Fh[j]) * Xij);  // (6.81) before projection
-          // (6.80): -c_IJ eps_IJ x_IJ/|x_IJ| with eps_IJ = error . x_IJ/|x_IJ|
-          hourglass -= (hourglassStiffness_[k] * error.dot(xij) / xij.squaredNorm()) * xij;
+          if constexpr (Ganzenmueller) hourglass += ganzenmueller_->pair(k, Xij, xij, Fh[i], Fh[j]);
+          if constexpr (Viscous)
+            viscous += viscosity_->pair(k, xij, (*velocity)[i] - (*velocity)[j]);
         }
       }
-      if constexpr (Hourglass) {
+      Vec<D> total = volume_[i] * internal;
+      if (energyHourglass_) total += energyHourglass_->springForce(i);
+      if constexpr (Ganzenmueller) {
         hourglassForce_[i] = volume_[i] * hourglass;
-        f[i] = volume_[i] * (internal + hourglass);
-      } else {
-        f[i] = volume_[i] * internal;
+        total += hourglassForce_[i];
       }
+      if constexpr (Viscous) {
+        viscousForce_[i] = volume_[i] * viscous;
+        total += viscousForce_[i];
+      }
+      f[i] = total;
     }
   }
 
   const ReferenceConfiguration<D>& ref_;
   const std::vector<Material>& materials_;
-  const std::vector<std::uint16_t>& materialOfParticle_;
   const std::vector<double>& volume_;
-  double alpha_;
-  std::vector<std::vector<Index>> particlesOfMaterial_;
+  HourglassSettings hourglass_;
+  std::vector<std::vector<Index>> particlesOfMaterial_;  // without the passive particles
+  std::vector<Index> passive_;
   std::vector<Mat<D>> F_;
   std::vector<Mat<D>> P_;
+  std::vector<Mat<D>> stress_;  // P + P^hg (energy form only; P^hg alone on the linear F)
+  std::vector<Vec<D>> linearReverse_, linearSum_;  // t^lin_IJ, G^lin_I (that case only)
   bool separateHourglassGradient_ = false;
   std::vector<Mat<D>> hourglassF_;
-  std::vector<double> hourglassStiffness_;
+  std::unique_ptr<EnergyHourglass<D>> energyHourglass_;
+  std::unique_ptr<GanzenmuellerHourglass<D>> ganzenmueller_;
+  std::unique_ptr<ArtificialViscosity<D>> viscosity_;
   std::vector<Vec<D>> hourglassForce_;
+  std::vector<Vec<D>> viscousForce_;
 };
 
 }  // namespace tlsph

@@ -1,0 +1,109 @@
+// The hourglass penalty as an energy (DESIGN.md section 2; the conservative form of
+// Ganzenmueller's (6.80)-(6.81)):
+//   E_hg = 1/4 sum_I sum_J k_IJ |e_IJ|^2,   e_IJ = x_IJ - 1/2 (F_I + F_J) X_IJ,   k_IJ = V_I c_IJ.
+// Its exact gradient has two parts: the spring  -sum_J k_IJ e_IJ  on I, and, through F, an
+// "hourglass stress"  P^hg_I = -1/2 sum_J c_IJ e_IJ (x) X_IJ  that the internal-force pass sends
+// through the same gradient vectors as P (dE = sum_I V_I P^hg_I : dF_I for the F-part).
+// Conservative, objective (e -> R e under x -> R x) and zero for every affine field; with
+// an F exact for quadratic fields it is zero for quadratic fields too.
+#pragma once
+
+#include <vector>
+
+#include "tlsph/ReferenceConfiguration.hpp"
+#include "tlsph/Types.hpp"
+
+namespace tlsph {
+
+template <int D>
+class EnergyHourglass {
+ public:
+  EnergyHourglass(const ReferenceConfiguration<D>& ref, std::vector<double> pairCoefficient,
+                  const std::vector<double>& volume)
+      : ref_(ref),
+        c_(std::move(pairCoefficient)),
+        volume_(volume),
+        spring_(ref.particleCount(), Vec<D>::Zero()),
+        sumCX_(ref.particleCount(), Vec<D>::Zero()),
+        sumCXX_(ref.particleCount(), Mat<D>::Zero()) {
+    const auto& nb = ref.neighbours;
+    for (Index i = 0; i < ref.particleCount(); ++i)
+      for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
+        sumCX_[i] += c_[k] * ref.separation[k];
+        sumCXX_[i] += c_[k] * ref.separation[k] * ref.separation[k].transpose();
+      }
+  }
+
+  // One pass over the pairs: stress[i] = P[i] + P^hg_i (what the force pass uses; P^hg_i
+  // alone when P is null) and the spring force on every particle. F is the gradient the
+  // penalty compares with; P^hg must go through that F's gradient vectors.
+  // With H = F - 1, e_IJ = (u_I - u_J) - 1/2 H_I X_IJ - 1/2 H_J X_IJ; the H_I part is summed
+  // once per particle through the constant moments sum_J c_IJ X_IJ and sum_J c_IJ X_IJ X_IJ^T.
+  void evaluate(const std::vector<Vec<D>>& u, const std::vector<Mat<D>>& F,
+                const std::vector<Mat<D>>* P, std::vector<Mat<D>>& stress) {
+    const auto& nb = ref_.neighbours;
+    const Index n = ref_.particleCount();
+#pragma omp parallel for schedule(static)
+    for (Index i = 0; i < n; ++i) {
+      const Vec<D> ui = u[i];
+      Vec<D> sum = Vec<D>::Zero();
+      Mat<D> moment = Mat<D>::Zero();
+      for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
+        const Index j = nb.neighbour[k];
+        const Vec<D>& Xij = ref_.separation[k];
+        const Vec<D> HjX = F[j] * Xij - Xij;
+        const Vec<D> w = c_[k] * ((ui - u[j]) - 0.5 * HjX);
+        sum += w;
+        moment.noalias() += w * Xij.transpose();
+      }
+      const Mat<D> Hi = F[i] - Mat<D>::Identity();
+      sum -= 0.5 * (Hi * sumCX_[i]);                // sum_J c_IJ e_IJ
+      moment.noalias() -= 0.5 * (Hi * sumCXX_[i]);  // sum_J c_IJ e_IJ (x) X_IJ
+      stress[i] = P ? Mat<D>((*P)[i] - 0.5 * moment) : Mat<D>(-0.5 * moment);  // P + P^hg
+      spring_[i] = -volume_[i] * sum;                                          // -sum_J k_IJ e_IJ
+    }
+  }
+
+  // Spring part of the force on particle i from the last evaluate().
+  const Vec<D>& springForce(Index i) const {
+    return spring_[i];
+  }
+
+  // E_hg = 1/4 sum_I V_I sum_J c_IJ |e_IJ|^2 for the displacements u and gradients F
+  // (a diagnostic pass, not part of the force).
+  double energy(const std::vector<Vec<D>>& u, const std::vector<Mat<D>>& F) const {
+    const auto& nb = ref_.neighbours;
+    const Index n = ref_.particleCount();
+    double total = 0.0;
+#pragma omp parallel for reduction(+ : total) schedule(static)
+    for (Index i = 0; i < n; ++i) {
+      double squares = 0.0;
+      for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
+        const Index j = nb.neighbour[k];
+        const Vec<D>& Xij = ref_.separation[k];
+        const Vec<D> e = (u[i] - u[j]) - 0.5 * ((F[i] + F[j]) * Xij - 2.0 * Xij);
+        squares += c_[k] * e.squaredNorm();
+      }
+      total += 0.25 * volume_[i] * squares;
+    }
+    return total;
+  }
+
+  // sum_J k_IJ: the spring stiffness particle i sees (for the stable time step).
+  double particleStiffness(Index i) const {
+    double sum = 0.0;
+    for (Index k = ref_.neighbours.offset[i]; k < ref_.neighbours.offset[i + 1]; ++k)
+      sum += c_[k];
+    return volume_[i] * sum;
+  }
+
+ private:
+  const ReferenceConfiguration<D>& ref_;
+  std::vector<double> c_;
+  const std::vector<double>& volume_;
+  std::vector<Vec<D>> spring_;
+  std::vector<Vec<D>> sumCX_;   // sum_J c_IJ X_IJ
+  std::vector<Mat<D>> sumCXX_;  // sum_J c_IJ X_IJ X_IJ^T
+};
+
+}  // namespace tlsph
