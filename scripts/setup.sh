@@ -7,6 +7,9 @@
 #   scripts/setup.sh example   install + build + run the main example scene
 #   scripts/setup.sh validate  install (+ numpy, matplotlib) + build + run the full validation
 #                              ladder (validation/run.py, ~30 min on 2 cores): validation/report/
+#   scripts/setup.sh stability install (+ numpy, matplotlib) + build + run the stability map
+#                              (validation/stability.py, ~15-25 min on 2 cores):
+#                              validation/report/stability.md
 #
 # Environment: BUILD_DIR (default build), JOBS (default: number of cores).
 set -euo pipefail
@@ -19,7 +22,7 @@ jobs="${JOBS:-$(nproc)}"
 packages=(cmake make g++ libeigen3-dev libboost-program-options-dev libvtk9-dev
   libgtest-dev googletest python3)
 # The validation report's plots need numpy and matplotlib (the quick check under ctest does not).
-if [ "$action" = validate ]; then
+if [ "$action" = validate ] || [ "$action" = stability ]; then
   packages+=(python3-numpy python3-matplotlib)
 fi
 
@@ -56,8 +59,15 @@ case "$action" in
     shift || true
     /usr/bin/python3 validation/run.py --build-dir "$build_dir" "$@"
     ;;
+  stability)
+    # The stability map: each case of validation/stability/ at the default time-step rule and
+    # swept in [time] cfl up to its measured limit; writes validation/report/stability.md,
+    # stability.json and the stability_*.png plots. Extra arguments go to the runner.
+    shift || true
+    /usr/bin/python3 validation/stability.py --build-dir "$build_dir" "$@"
+    ;;
   *)
-    echo "usage: scripts/setup.sh [build|test|example|validate]" >&2
+    echo "usage: scripts/setup.sh [build|test|example|validate|stability]" >&2
     exit 2
     ;;
 esac
