@@ -52,7 +52,6 @@ import fnmatch
 import json
 import math
 import os
-import platform
 import shlex
 import shutil
 import subprocess
@@ -420,49 +419,9 @@ def select(only):
 # Running
 
 
-def rel(path):
-    try:
-        return str(Path(path).resolve().relative_to(ROOT))
-    except ValueError:
-        return str(path)
+# rel, git_state and machine_info are the validation runner's own (validation/run.py).
+from run import git_state, machine_info, rel  # noqa: E402
 
-
-def git_state():
-    env = dict(os.environ, GIT_OPTIONAL_LOCKS="0")  # read-only: never refresh the index
-
-    def git(*args):
-        try:
-            return subprocess.run(["git", "-C", str(ROOT), "--no-optional-locks", *args],
-                                  capture_output=True, text=True, env=env,
-                                  timeout=60).stdout.rstrip("\n")
-        except (OSError, subprocess.SubprocessError):
-            return ""
-
-    head = git("rev-parse", "HEAD").strip() or "unknown"
-    changed = [line for line in git("status", "--porcelain").splitlines()
-               if line.strip() and not line[3:].startswith(("validation/runs/",
-                                                            "validation/report/"))]
-    return {"commit": head + ("-dirty" if changed else ""), "changed": changed}
-
-
-def machine_info(threads, build_dir):
-    cpu = ""
-    try:
-        for line in open("/proc/cpuinfo"):
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    version = ""
-    try:
-        version = subprocess.run([str(Path(build_dir) / "tlsph"), "--version"],
-                                 capture_output=True, text=True, timeout=30).stdout.strip()
-    except (OSError, subprocess.SubprocessError):
-        pass
-    return {"cpu": cpu, "cores": os.cpu_count(), "threads": threads,
-            "platform": platform.platform(), "python": platform.python_version(),
-            "tlsph_version": version, "build_dir": rel(build_dir)}
 
 
 def fmt_cfl(c):
