@@ -102,17 +102,29 @@ def compute_references():
 
 
 def read_series(path):
-    """A tlsph CSV series: '#' preamble lines, a header row, numbers. Returns {column: list}."""
+    """A tlsph CSV series: '#' preamble lines, a header row, numbers. Returns {column: list};
+    {} for a missing file, NaN for a field that is not a number, and a row cut short (a run
+    stopped while writing) is dropped."""
     header, rows = None, []
-    with open(path) as f:
-        for line in f:
-            line = line.strip()
-            if not line or line.startswith("#"):
-                continue
-            if header is None:
-                header = line.split(",")
-                continue
-            rows.append([float(x) for x in line.split(",")])
+    try:
+        with open(path) as f:
+            for line in f:
+                line = line.strip()
+                if not line or line.startswith("#"):
+                    continue
+                if header is None:
+                    header = line.split(",")
+                    continue
+                vals = []
+                for x in line.split(","):
+                    try:
+                        vals.append(float(x))
+                    except ValueError:
+                        vals.append(float("nan"))
+                if len(vals) == len(header):
+                    rows.append(vals)
+    except OSError:
+        return {}
     if header is None:
         return {}
     return {h: [r[i] for r in rows] for i, h in enumerate(header)}

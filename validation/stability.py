@@ -77,33 +77,6 @@ WAIT_POLICY = None  # OMP_WAIT_POLICY of the runs (--wait-policy)
 # Reading a run
 
 
-def read_series(path):
-    """A tlsph CSV series: '#' preamble lines, a header row, numbers. Returns {column: list}."""
-    header, rows = None, []
-    try:
-        with open(path) as f:
-            for line in f:
-                line = line.strip()
-                if not line or line.startswith("#"):
-                    continue
-                if header is None:
-                    header = line.split(",")
-                    continue
-                vals = []
-                for x in line.split(","):
-                    try:
-                        vals.append(float(x))
-                    except ValueError:
-                        vals.append(float("nan"))
-                if len(vals) == len(header):
-                    rows.append(vals)
-    except OSError:
-        return {}
-    if header is None:
-        return {}
-    return {h: [r[i] for r in rows] for i, h in enumerate(header)}
-
-
 def finite(x):
     return x is not None and isinstance(x, (int, float)) and math.isfinite(x)
 
@@ -420,7 +393,7 @@ def select(only):
 
 
 # rel, git_state and machine_info are the validation runner's own (validation/run.py).
-from run import git_state, machine_info, rel  # noqa: E402
+from run import git_state, machine_info, read_series, rel  # noqa: E402
 
 
 
