@@ -89,14 +89,6 @@ class EnergyHourglass {
     return total;
   }
 
-  // sum_J k_IJ: the spring stiffness particle i sees (for the stable time step).
-  double particleStiffness(Index i) const {
-    double sum = 0.0;
-    for (Index k = ref_.neighbours.offset[i]; k < ref_.neighbours.offset[i + 1]; ++k)
-      sum += c_[k];
-    return volume_[i] * sum;
-  }
-
  private:
   const ReferenceConfiguration<D>& ref_;
   std::vector<double> c_;

@@ -25,8 +25,6 @@ class GanzenmuellerHourglass {
     return (-c_[k] * error.dot(xij) / xij.squaredNorm()) * xij;  // (6.80)
   }
 
-  double pairCoefficient(Index k) const { return c_[k]; }
-
  private:
   std::vector<double> c_;
 };

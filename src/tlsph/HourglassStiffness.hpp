@@ -36,4 +36,20 @@ std::vector<double> hourglassPairCoefficients(const ReferenceConfiguration<D>& r
   return c;
 }
 
+// K_I = sum_J k_IJ = V_I sum_J c_IJ: the penalty's spring stiffness at each particle (for the
+// stable time step).
+template <int D>
+std::vector<double> hourglassParticleStiffness(const ReferenceConfiguration<D>& ref,
+                                               const std::vector<double>& c,
+                                               const std::vector<double>& volume) {
+  const auto& nb = ref.neighbours;
+  std::vector<double> K(ref.particleCount(), 0.0);
+  for (Index i = 0; i < ref.particleCount(); ++i) {
+    for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k)
+      K[i] += c[k];
+    K[i] *= volume[i];
+  }
+  return K;
+}
+
 }  // namespace tlsph

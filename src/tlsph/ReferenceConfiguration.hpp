@@ -47,6 +47,12 @@ struct ReferenceConfiguration {
   Index particleCount() const { return neighbours.particleCount(); }
 };
 
+// t_IJ = (V_J / V_I) g_JI for every pair (I, J) of the (symmetric, sorted) full lists: the
+// reverse pair's vector, so a force -dE/du_I is gathered from I's own list.
+template <int D>
+std::vector<Vec<D>> reverseVectors(const NeighbourList& nb, const std::vector<Vec<D>>& g,
+                                   const std::vector<double>& volume);
+
 // Smallest accepted reciprocal condition number of L_I (sigma_min / sigma_max).
 inline constexpr double kDefaultMinCorrectionCondition = 1e-6;
 

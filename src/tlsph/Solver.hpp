@@ -50,13 +50,7 @@ class Solver {
                 mirrorGhostList(scene)) {
     if (!(settings.cfl > 0.0)) throw SetupError("the CFL number must be positive");
     const auto& p = scene.particles;
-    std::vector<double> hourglassStiffness;
-    if (forces_.hourglassEnabled()) {
-      hourglassStiffness.resize(p.size());
-      for (Index i = 0; i < p.size(); ++i)
-        hourglassStiffness[i] = forces_.hourglassStiffness(i);
-    }
-    stable_ = stableStep(p, scene.materials, settings.cfl, hourglassStiffness);
+    stable_ = stableStep(p, scene.materials, settings.cfl, forces_.hourglassStiffness());
     dt_ = settings.timeStep > 0.0 ? settings.timeStep : stable_.dt;
     std::vector<int> slot(p.size(), -1);
     for (Index i = 0; i < p.size(); ++i) {

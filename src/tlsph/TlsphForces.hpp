@@ -10,9 +10,9 @@
 // term that is off is not computed and the loops carry no branch on options.
 #pragma once
 
-#include <algorithm>
 #include <cstdint>
 #include <memory>
+#include <type_traits>
 #include <variant>
 #include <vector>
 
@@ -57,6 +57,7 @@ class TlsphForces {
     if (hourglass.enabled()) {
       auto c = hourglassPairCoefficients(reference, materials, materialOfParticle, volume,
                                          hourglass.alpha, isPassive);
+      hourglassStiffness_ = hourglassParticleStiffness(reference, c, volume);
       // The textbook form always compares with the linear F; the energy form with the one
       // chosen. With the linear correction there is only one F.
       const bool linearF = hourglass.form == HourglassForm::Ganzenmueller ||
@@ -79,13 +80,6 @@ class TlsphForces {
     }
   }
 
-  // The textbook penalty alone (tests and benchmarks of the chapter's form).
-  TlsphForces(const ReferenceConfiguration<D>& reference, const std::vector<Material>& materials,
-              const std::vector<std::uint16_t>& materialOfParticle,
-              const std::vector<double>& volume, double alpha)
-      : TlsphForces(reference, materials, materialOfParticle, volume,
-                    HourglassSettings{alpha, HourglassForm::Ganzenmueller}) {}
-
   bool hourglassEnabled() const { return hourglass_.enabled(); }
   double hourglassCoefficient() const { return hourglass_.alpha; }
   const HourglassSettings& hourglass() const { return hourglass_; }
@@ -101,9 +95,10 @@ class TlsphForces {
                const std::vector<Vec<D>>* v = nullptr) {
     for (std::size_t m = 0; m < materials_.size(); ++m)
       std::visit(
-          [&](const auto& model) { deformationAndStress(model, particlesOfMaterial_[m], u); },
+          [&](const auto& model) { deformationAndStress(&model, particlesOfMaterial_[m], u); },
           materials_[m]);
-    if (!passive_.empty()) passiveDeformation(u);
+    // Passive particles (mirrored ghosts): F for the penalty and the output, P stays zero.
+    if (!passive_.empty()) deformationAndStress<void>(nullptr, passive_, u);
     const bool viscous = viscosity_ && v != nullptr;
     if (energyHourglass_ && separateHourglassGradient_) {
       // P^hg of the linear F goes through the linear gradient vectors: its own sum.
@@ -156,61 +151,46 @@ class TlsphForces {
                : 0.0;
   }
 
-  // sum_J k_IJ = V_I sum_J c_IJ: the penalty's spring stiffness at particle i (0 when off).
-  double hourglassStiffness(Index i) const {
-    if (!hourglass_.enabled()) return 0.0;
-    if (energyHourglass_) return energyHourglass_->particleStiffness(i);
-    double sum = 0.0;
-    for (Index k = ref_.neighbours.offset[i]; k < ref_.neighbours.offset[i + 1]; ++k)
-      sum += ganzenmueller_->pairCoefficient(k);
-    return volume_[i] * sum;
+  // K_I = sum_J k_IJ per particle: the penalty's spring stiffness (empty when it is off).
+  const std::vector<double>& hourglassStiffness() const {
+    return hourglassStiffness_;
   }
 
  private:
+  // F_I = 1 + sum_J (u_J - u_I) (x) g_IJ (6.69), for the gradient vectors g given.
+  Mat<D> deformationGradientOf(Index i, const std::vector<Vec<D>>& u,
+                               const std::vector<Vec<D>>& g) const {
+    const auto& nb = ref_.neighbours;
+    const Vec<D> ui = u[i];
+    Mat<D> gradU = Mat<D>::Zero();
+    for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k)
+      gradU.noalias() += (u[nb.neighbour[k]] - ui) * g[k].transpose();
+    return Mat<D>::Identity() + gradU;
+  }
+
+  // F (and the penalty's own linear F where it has one) of the particles in group; their
+  // stress P unless Model is void (the passive particles).
   template <class Model>
-  void deformationAndStress(const Model& model, const std::vector<Index>& group,
+  void deformationAndStress(const Model* model, const std::vector<Index>& group,
                             const std::vector<Vec<D>>& u) {
     const auto& nb = ref_.neighbours;
     const Index count = static_cast<Index>(group.size());
-    if (separateHourglassGradient_) {
-      // The penalty's own (linear-corrected) deformation gradient.
-#pragma omp parallel for schedule(static)
-      for (Index p = 0; p < count; ++p) {
-        const Index i = group[p];
-        Mat<D> gradU = Mat<D>::Zero();
-        for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k)
-          gradU.noalias() += (u[nb.neighbour[k]] - u[i]) * ref_.linearGradient[k].transpose();
-        hourglassF_[i] = Mat<D>::Identity() + gradU;
-      }
-    }
 #pragma omp parallel for schedule(static)
     for (Index p = 0; p < count; ++p) {
       const Index i = group[p];
+      // deformationGradientOf written out: the hot loop measured 2-3 % slower through the call
       const Vec<D> ui = u[i];
       Mat<D> gradU = Mat<D>::Zero();
       for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k)
         gradU.noalias() += (u[nb.neighbour[k]] - ui) * ref_.correctedGradient[k].transpose();
       const Mat<D> F = Mat<D>::Identity() + gradU;  // (6.69)
       F_[i] = F;
-      P_[i] = firstPiolaKirchhoff<D>(model, F);
+      if constexpr (!std::is_void_v<Model>) P_[i] = firstPiolaKirchhoff<D>(*model, F);
     }
-  }
-
-  // F of the passive particles (the hourglass penalty and the output use it); P stays zero.
-  void passiveDeformation(const std::vector<Vec<D>>& u) {
-    const auto& nb = ref_.neighbours;
-    const Index count = static_cast<Index>(passive_.size());
+    if (separateHourglassGradient_) {
 #pragma omp parallel for schedule(static)
-    for (Index p = 0; p < count; ++p) {
-      const Index i = passive_[p];
-      Mat<D> gradU = Mat<D>::Zero(), gradUlin = Mat<D>::Zero();
-      for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
-        gradU.noalias() += (u[nb.neighbour[k]] - u[i]) * ref_.correctedGradient[k].transpose();
-        if (separateHourglassGradient_)
-          gradUlin.noalias() += (u[nb.neighbour[k]] - u[i]) * ref_.linearGradient[k].transpose();
-      }
-      F_[i] = Mat<D>::Identity() + gradU;
-      if (separateHourglassGradient_) hourglassF_[i] = Mat<D>::Identity() + gradUlin;
+      for (Index p = 0; p < count; ++p)
+        hourglassF_[group[p]] = deformationGradientOf(group[p], u, ref_.linearGradient);
     }
   }
 
@@ -218,18 +198,11 @@ class TlsphForces {
   // the stress uses the quadratic correction.
   void linearReverseGradients(const std::vector<double>& volume) {
     const auto& nb = ref_.neighbours;
-    const Index n = ref_.particleCount();
-    linearReverse_.resize(nb.pairCount());
-    linearSum_.assign(n, Vec<D>::Zero());
-    for (Index i = 0; i < n; ++i)
-      for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
-        const Index j = nb.neighbour[k];
-        const auto first = nb.neighbour.begin() + nb.offset[j];
-        const auto at = std::lower_bound(first, nb.neighbour.begin() + nb.offset[j + 1], i);
-        const Index back = static_cast<Index>(at - nb.neighbour.begin());
-        linearReverse_[k] = (volume[j] / volume[i]) * ref_.linearGradient[back];
+    linearReverse_ = reverseVectors<D>(nb, ref_.linearGradient, volume);
+    linearSum_.assign(ref_.particleCount(), Vec<D>::Zero());
+    for (Index i = 0; i < ref_.particleCount(); ++i)
+      for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k)
         linearSum_[i] += ref_.linearGradient[k];
-      }
   }
 
   template <bool Ganzenmueller, bool Viscous, bool SeparateHourglassStress = false>
@@ -286,6 +259,7 @@ class TlsphForces {
   std::vector<Vec<D>> linearReverse_, linearSum_;  // t^lin_IJ, G^lin_I (that case only)
   bool separateHourglassGradient_ = false;
   std::vector<Mat<D>> hourglassF_;
+  std::vector<double> hourglassStiffness_;  // K_I
   std::unique_ptr<EnergyHourglass<D>> energyHourglass_;
   std::unique_ptr<GanzenmuellerHourglass<D>> ganzenmueller_;
   std::unique_ptr<ArtificialViscosity<D>> viscosity_;
