@@ -169,3 +169,86 @@ TEST(SceneInput, ExamplesBuild) {
       EXPECT_NO_THROW(buildScene<3>(config)) << path;
   }
 }
+
+TEST(SceneInput, BadClampMethodAndFace) {
+  expectError(errorOf(replaced(kGood, "face = x-", "face = x-\nmethod = mirrored")),
+              {"scene.ini", "[clamp.root]", "method", "'mirrored'", "mirror", "fixed"});
+  expectError(errorOf(replaced(kGood, "face = x-", "face = z-")),
+              {"[clamp.root]", "face", "'z-'", "x-", "y+"});
+  expectError(errorOf(replaced(kGood, "face = x-", "face = left")),
+              {"[clamp.root]", "face", "'left'"});
+  expectError(errorOf(replaced(kGood, "face = x-", "face = x-\nmotion = spin")),
+              {"[clamp.root]", "motion", "'spin'", "rotation"});
+  expectError(errorOf(replaced(kGood, "face = x-", "face = x-\nmotion = displacement")),
+              {"[clamp.root]", "value", "missing"});
+  // The quadratic extrapolation needs one body layer more than the ghost layers.
+  const std::string thin = replaced(
+      replaced(kGood, "lower = 0.19 0\nupper = 0.2 0.04", "lower = 0.02 0\nupper = 0.03 0.04"),
+      "upper = 0.2 0.04", "upper = 0.03 0.04");
+  EXPECT_EQ(errorOf(thin), "");  // three layers: enough for the odd reflection
+  expectError(errorOf(replaced(thin, "face = x-", "face = x-\nmethod = mirror-quadratic")),
+              {"[clamp.root]", "method", "thinner than 4 layers", "method = fixed"});
+}
+
+TEST(SceneInput, MovingClampIsAPrescriptionFollowedByItsGhosts) {
+  const SceneSetup<2> setup = buildScene<2>(Config::parse(
+      replaced(kGood, "face = x-", "face = x-\nmotion = displacement\nvalue = 0.001 0\nramp = 0.1"),
+      "scene.ini"));
+  ASSERT_EQ(setup.scene.prescriptions.size(), 1u);
+  const auto& rule = setup.scene.prescriptions[0];
+  EXPECT_EQ(rule.name, "clamp.root");
+  EXPECT_TRUE(rule.particles.empty());  // mirrored: the ghosts follow by reflection
+  EXPECT_EQ(rule.motion, PrescribedMotion::Displacement);
+  EXPECT_EQ(setup.scene.mirrorGhosts.size(), 3u * 4u);
+  for (const auto& m : setup.scene.mirrorGhosts)
+    EXPECT_EQ(m.motion, 0);
+}
+
+TEST(SceneInput, LoadOnAFaceTakesTheSurfaceLayerOnly) {
+  // A half-space catching two layers at x+: a traction warns; face = x+ takes one layer.
+  const std::string twoLayers = replaced(replaced(kGood, "lower = 0.19 0", "lower = 0.18 0"),
+                                         "type = force", "type = traction");
+  const SceneSetup<2> warned = buildScene<2>(Config::parse(twoLayers, "scene.ini"));
+  ASSERT_EQ(warned.warnings.size(), 1u);
+  for (const std::string part :
+       {"[load.pull]", "2 of the 8 particles", "not on the body's surface", "face = "})
+    EXPECT_NE(warned.warnings[0].find(part), std::string::npos) << warned.warnings[0];
+  EXPECT_EQ(warned.scene.loads[0].particles.size(), 8u);
+
+  const SceneSetup<2> face =
+      buildScene<2>(Config::parse(replaced(twoLayers, "region = tip", "face = x+"), "scene.ini"));
+  EXPECT_TRUE(face.warnings.empty());
+  ASSERT_EQ(face.scene.loads[0].particles.size(), 4u);
+  double total = 0.0;
+  for (std::size_t k = 0; k < 4; ++k) {
+    const Index i = face.scene.loads[0].particles[k];
+    EXPECT_NEAR(face.scene.particles.referencePosition[i].x(), 0.195, 1e-12);
+    total += face.scene.loads[0].force[k].x();
+  }
+  EXPECT_NEAR(total, 10.0 * 0.04, 1e-12);  // traction x the face's length
+
+  // face and region together: the face's particles inside the region.
+  const SceneSetup<2> both = buildScene<2>(Config::parse(
+      replaced(replaced(twoLayers, "upper = 0.2 0.04\n[load", "upper = 0.2 0.02\n[load"),
+               "region = tip", "region = tip\nface = x+"),
+      "scene.ini"));
+  EXPECT_EQ(both.scene.loads[0].particles.size(), 2u);
+
+  expectError(errorOf(replaced(kGood, "region = tip", "face = x")),
+              {"[load.pull]", "face", "'x'", "x+"});
+  expectError(errorOf(replaced(kGood, "region = tip", "region = tip\nface = x-")),
+              {"[load.pull]", "face", "no particle on face x-"});
+}
+
+TEST(SceneInput, HolesRemoveParticles) {
+  const std::string withHole =
+      kGood + "[hole.h]\nshape = cylinder\ncentre = 0.1 0.02\nradius = 0.011\n";
+  const SceneSetup<2> setup = buildScene<2>(Config::parse(withHole, "scene.ini"));
+  const SceneSetup<2> plain = buildScene<2>(Config::parse(kGood, "scene.ini"));
+  // The disc of radius 1.1 dx around a lattice corner holds the 4 cell centres at 0.71 dx.
+  EXPECT_EQ(plain.scene.particles.size() - setup.scene.particles.size(), 4);
+  for (Index i = 0; i < setup.scene.particles.size(); ++i)
+    EXPECT_GT((setup.scene.particles.referencePosition[i] - Vec<2>(0.1, 0.02)).norm(), 0.011);
+  expectError(errorOf(kGood + "[hole.h]\nshape = half-space\npoint = 0 0\nnormal = 1 0\n"),
+              {"[hole.h]", "shape", "'half-space'"});
+}

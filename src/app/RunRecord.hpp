@@ -129,7 +129,30 @@ void writeRunRecord(const std::filesystem::path& file, const SceneSetup<D>& setu
       << ", \"failed_frame\": " << jsonText(u.failedFrame.string()) << "}";
     field("instability", o.str());
   }
-  field("probes", jsonText(s.probes.string()), true);
+  field("probes", jsonText(s.probes.string()));
+  field("reactions_series", jsonText(s.reactions.string()));
+  {
+    // The force each clamp and prescription exerts on the body at the end [N; 2D: N/m].
+    std::ostringstream o;
+    o << "{";
+    for (std::size_t r = 0; r < s.finalReactions.size(); ++r) {
+      const auto& [name, R] = s.finalReactions[r];
+      o << (r ? ", " : "") << jsonText(name) << ": [";
+      for (int a = 0; a < D; ++a)
+        o << (a ? ", " : "") << jsonNumber(R[a]);
+      o << "]";
+    }
+    o << "}";
+    field("reactions", o.str());
+  }
+  {
+    std::ostringstream o;
+    o << "[";
+    for (std::size_t k = 0; k < setup.warnings.size(); ++k)
+      o << (k ? ", " : "") << jsonText(setup.warnings[k]);
+    o << "]";
+    field("warnings", o.str(), true);
+  }
   j << "}\n";
   writeAtomically(file, [&](const std::filesystem::path& tmp) {
     std::ofstream out(tmp);

@@ -38,7 +38,9 @@ struct RunSummary {
   double wallSeconds = 0.0;
   double residual = 0.0;
   EnergyBalance energy;
-  std::filesystem::path pvd, energies, probes;
+  std::filesystem::path pvd, energies, probes, reactions;
+  // Final force each clamp and prescription exerts on the body (Solver::reaction), by name.
+  std::vector<std::pair<std::string, Vec3>> finalReactions;
   std::string message;
   std::optional<Instability> instability;  // set when the outcome is Unstable
 };
@@ -105,6 +107,26 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
     probes->setPreamble(preamble);
   }
 
+  // reactions.csv: the force each clamp and prescription exerts on the body.
+  std::unique_ptr<CsvSeries> reactions;
+  const auto& rules = setup.scene.prescriptions;
+  if (!rules.empty()) {
+    std::vector<std::string> columns = {"time", "step"};
+    for (const auto& rule : rules)
+      for (int a = 0; a < D; ++a)
+        columns.push_back(rule.name + "_" + "xyz"[a]);
+    reactions = std::make_unique<CsvSeries>(dir / "reactions.csv", columns);
+    reactions->setPreamble(preamble);
+  }
+  auto reactionRow = [&] {
+    std::vector<double> row = {solver.time(), double(solver.stepCount())};
+    for (std::size_t r = 0; r < rules.size(); ++r) {
+      const Vec<D> R = solver.reaction(r);
+      row.insert(row.end(), R.data(), R.data() + D);
+    }
+    return row;
+  };
+
   auto recordSeries = [&] {
     const EnergyBalance e = solver.energyBalance();
     Vec3 momentum = Vec3::Zero();
@@ -113,6 +135,7 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
                      e.externalWork, e.boundaryWork, e.damped, e.total(), solver.residualRatio(),
                      momentum.x(), momentum.y(), momentum.z()});
     if (probes) probes->append(probeRow(setup, solver));
+    if (reactions) reactions->append(reactionRow());
   };
   long lastFrameStep = -1;
   auto writeFrame = [&] {
@@ -120,6 +143,7 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
     lastFrameStep = solver.stepCount();
     energies.flush();
     if (probes) probes->flush();
+    if (reactions) reactions->flush();
   };
 
   RunSummary summary;
@@ -191,6 +215,7 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
   } else {
     energies.flush();
     if (probes) probes->flush();
+    if (reactions) reactions->flush();
     summary.energy = solver.energyBalance();  // the failing state's books
     guard.writeFrames(*summary.instability);  // leaves the solver in the last good state
   }
@@ -198,6 +223,12 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
   if (vtu) summary.pvd = vtu->pvdPath();
   summary.energies = dir / "energies.csv";
   if (probes) summary.probes = dir / "probes.csv";
+  if (reactions) summary.reactions = dir / "reactions.csv";
+  for (std::size_t r = 0; r < rules.size(); ++r) {
+    Vec3 R = Vec3::Zero();
+    R.head<D>() = solver.reaction(r);
+    summary.finalReactions.emplace_back(rules[r].name, R);
+  }
   return summary;
 }
 

@@ -135,6 +135,8 @@ void printSetup(const SceneSetup<D>& setup, const Solver<D>& solver) {
 template <int D>
 int runOrCheck(const Config& config, bool run, bool progress, const std::string& command) {
   SceneSetup<D> setup = buildScene<D>(config);
+  for (const auto& warning : setup.warnings)
+    std::cerr << command << ": warning: " << warning << "\n";
   if (!run) {
     Scene<D> copy = setup.scene;  // the check builds the solver's set-up without running
     Solver<D> solver(copy, setup.solver);

@@ -15,7 +15,7 @@ namespace po = boost::program_options;
 namespace {
 
 // Sections whose second component is a user-chosen name: [material.steel], [region.tip], ...
-const std::set<std::string> kNamedKinds = {"material",  "body", "region",  "clamp",
+const std::set<std::string> kNamedKinds = {"material",  "body", "hole",    "region", "clamp",
                                            "prescribe", "load", "initial", "probe"};
 
 std::pair<std::string, std::string> splitKey(const std::string& dotted) {

@@ -226,9 +226,20 @@ class Builder {
       r.finish();
       setup_.bodyNames.push_back(name);
     }
+    std::vector<Shape<D>> holes;
+    for (const auto& name : config_.namesOf("hole")) {
+      SectionReader r(config_, "hole." + name);
+      holes.push_back(readShape<D>(r, false));
+      r.finish();
+    }
     std::vector<Vec<D>> points;
     try {
       points = fillLattice<D>(shapes, setup_.dx, Vec<D>::Zero(), maxParticles_);
+      // [hole.NAME]: the lattice points inside a hole belong to no body.
+      std::erase_if(points, [&](const Vec<D>& X) {
+        return std::any_of(holes.begin(), holes.end(),
+                           [&](const Shape<D>& h) { return contains(h, X); });
+      });
     } catch (const std::length_error& e) {
       throw InputError(config_.where("scene", "dx"), "scene", "dx",
                        std::string(e.what()) +
@@ -307,22 +318,66 @@ class Builder {
     return it == latticeIndex_.end() ? -1 : it->second;
   }
 
+  static std::vector<std::string> faceNames() {
+    std::vector<std::string> faces = {"x-", "x+", "y-", "y+"};
+    if (D == 3) faces.insert(faces.end(), {"z-", "z+"});
+    return faces;
+  }
+
+  // The bodies' bounding box (body particles' reference positions).
+  const Eigen::AlignedBox<double, D>& bodyBox() {
+    if (bodyBox_.isEmpty())
+      for (Index i = 0; i < bodyCount_; ++i)
+        bodyBox_.extend(setup_.scene.particles.referencePosition[i]);
+    return bodyBox_;
+  }
+
+  // Whether body particle i lies in the layer of particles at the bodies' extreme along `face`
+  // ("x-", ..., "z+"): the particles a clamp mirrors and a face load acts on.
+  bool onBoundingFace(Index i, const std::string& face) {
+    const int axis = face[0] - 'x';
+    const double edge = face[1] == '-' ? bodyBox().min()[axis] : bodyBox().max()[axis];
+    return std::abs(setup_.scene.particles.referencePosition[i][axis] - edge) <= 0.25 * setup_.dx;
+  }
+
+  // A traction acts on the area dx^(d-1) of each particle it is given to, so a region that
+  // holds particles below the surface applies it more than once: say so.
+  void warnInteriorTraction(const Load<D>& load, const std::string& regionName) {
+    const auto& X = setup_.scene.particles.referencePosition;
+    Index interior = 0, example = -1;
+    for (Index i : load.particles) {
+      bool surface = false;
+      for (int a = 0; a < D && !surface; ++a)
+        for (double s : {-1.0, 1.0}) {
+          Vec<D> Y = X[i];
+          Y[a] += s * setup_.dx;
+          if (latticeParticle(Y) < 0) surface = true;
+        }
+      if (!surface && interior++ == 0) example = i;
+    }
+    if (interior == 0) return;
+    setup_.warnings.push_back(
+        config_.where(load.name, regionName.empty() ? "" : "region") + ": [" + load.name + "] " +
+        std::to_string(interior) + " of the " + std::to_string(load.particles.size()) +
+        " particles the traction acts on are not on the body's surface (e.g. particle " +
+        std::to_string(example) + " at " + fmt<D>(X[example]) +
+        "): each gets the traction times its area dx^" + std::to_string(D - 1) +
+        ", so the load counts the layers below the surface too; give face = x-|x+|... (with "
+        "the region) to load the surface layer only");
+  }
+
   void addClamps() {
     const int layersNeeded = static_cast<int>(std::ceil(supportRatio_ - 1e-9));
     auto& p = setup_.scene.particles;
     const auto& X = p.referencePosition;
-    Eigen::AlignedBox<double, D> box;
-    for (Index i = 0; i < bodyCount_; ++i)
-      box.extend(X[i]);
     std::set<std::string> facesUsed;
     for (const auto& name : config_.namesOf("clamp")) {
       SectionReader r(config_, "clamp." + name);
-      std::vector<std::string> faces = {"x-", "x+", "y-", "y+"};
-      if (D == 3) faces.insert(faces.end(), {"z-", "z+"});
-      const std::string face = r.word("face", std::nullopt, faces);
+      const std::string face = r.word("face", std::nullopt, faceNames());
       if (!facesUsed.insert(face).second)
         throw r.error("face", "face " + face + " is clamped twice");
-      const std::string method = r.word("method", "mirror", {"mirror", "fixed"});
+      const std::string method =
+          r.word("method", "mirror", {"mirror", "mirror-quadratic", "fixed"});
       const long layers = r.integer("layers", layersNeeded);
       if (layers < layersNeeded)
         throw r.error("layers", std::to_string(layers) +
@@ -330,49 +385,95 @@ class Builder {
                                     "(H/dx = " +
                                     fmt(supportRatio_) + " needs " + std::to_string(layersNeeded) +
                                     ")");
+      Prescription<D> clamp;
+      clamp.name = "clamp." + name;
+      const std::string motion = readMotion(r, clamp);
       r.finish();
       const int axis = face[0] - 'x';
       const double sign = face[1] == '-' ? -1.0 : 1.0;
-      const double edge = sign < 0 ? box.min()[axis] : box.max()[axis];
-      const bool mirror = method == "mirror";
-      Prescription<D> clamp;
-      clamp.name = "clamp." + name;
+      const bool mirror = method != "fixed";
+      const bool quadratic = method == "mirror-quadratic";
+      const int rule = static_cast<int>(setup_.scene.prescriptions.size());
       const double V = std::pow(setup_.dx, D);
       Index ghosts = 0;
       for (Index i = 0; i < bodyCount_; ++i) {
-        if (std::abs(X[i][axis] - edge) > 0.25 * setup_.dx) continue;
+        if (!onBoundingFace(i, face)) continue;
         for (long k = 1; k <= layers; ++k) {
           Vec<D> G = X[i];
           G[axis] += sign * k * setup_.dx;
-          Index image = -1;
+          MirrorGhost m;
           if (mirror) {
-            // ghost layer k mirrors body layer k across the face, half a spacing outside X_i
-            Vec<D> M = X[i];
-            M[axis] -= sign * (k - 1) * setup_.dx;
-            image = latticeParticle(M);
-            if (image < 0)
-              throw r.error("method", "the body is thinner than " + std::to_string(layers) +
-                                          " layers behind face " + face + " at (" + fmt<D>(M) +
-                                          "): a mirrored clamp needs a body particle there; "
-                                          "use method = fixed");
+            // Ghost layer k mirrors body layer k across the face (half a spacing outside X_i);
+            // the quadratic extrapolation also uses body layer k + 1 (MirrorGhost).
+            const long needed = quadratic ? k + 1 : k;
+            for (long l = k; l <= needed; ++l) {
+              Vec<D> M = X[i];
+              M[axis] -= sign * (l - 1) * setup_.dx;
+              const Index image = latticeParticle(M);
+              if (image < 0)
+                throw r.error("method", "the body is thinner than " + std::to_string(needed) +
+                                            " layers behind face " + face + " at (" + fmt<D>(M) +
+                                            "): method = " + method +
+                                            " needs a body particle there; use method = "
+                                            "fixed");
+              (l == k ? m.mirror : m.second) = image;
+            }
+            if (quadratic) {
+              // Lagrange extrapolation through u_p on the face, body layers k and k + 1.
+              m.w1 = -2.0 * k;
+              m.w2 = (2.0 * k - 1.0) * (2.0 * k - 1.0) / (2.0 * k + 1.0);
+            }
+            m.motion = rule;
           }
-          const std::uint16_t m = p.material[i];
-          const Index g = p.add(G, V, density(setup_.scene.materials[m]) * V, m,
+          const std::uint16_t mat = p.material[i];
+          const Index g = p.add(G, V, density(setup_.scene.materials[mat]) * V, mat,
                                 mirror ? Motion::Mirrored : Motion::Prescribed);
-          if (mirror)
-            setup_.scene.mirrorGhosts.push_back({g, image});
-          else
+          if (mirror) {
+            m.ghost = g;
+            setup_.scene.mirrorGhosts.push_back(m);
+          } else {
             clamp.particles.push_back(g);
+          }
           setup_.body.push_back(setup_.body[i]);
           setup_.ghost.push_back(1);
           ++ghosts;
         }
       }
-      setup_.conditions.push_back("clamp." + name + ": face " + face + ", " + method + ", " +
-                                  std::to_string(layers) + " ghost layers, " +
-                                  std::to_string(ghosts) + " ghost particles");
-      if (!mirror) setup_.scene.prescriptions.push_back(std::move(clamp));
+      setup_.conditions.push_back(
+          "clamp." + name + ": face " + face + ", " + method + ", " +
+          (motion == "fixed" ? "" : motion + " " + motionText(clamp) + ", ") +
+          std::to_string(layers) + " ghost layers, " + std::to_string(ghosts) + " ghost particles");
+      // A mirrored clamp's rule has no particles: its ghosts follow it by reflection.
+      setup_.scene.prescriptions.push_back(std::move(clamp));
     }
+  }
+
+  // The `motion` of a prescription or a clamp and its keys; returns the motion's name.
+  std::string readMotion(SectionReader& r, Prescription<D>& rule) {
+    const std::string motion =
+        r.word("motion", "fixed", {"fixed", "velocity", "displacement", "rotation"});
+    rule.motion = motion == "fixed"          ? PrescribedMotion::Fixed
+                  : motion == "velocity"     ? PrescribedMotion::Velocity
+                  : motion == "displacement" ? PrescribedMotion::Displacement
+                                             : PrescribedMotion::Rotation;
+    if (rule.motion == PrescribedMotion::Rotation) {
+      // Rigid rotation about the axis through `point` at `rate` rad/s (times the ramp).
+      rule.axis = rotationAxis<D>(r);
+      rule.point = r.vector<D>("point");
+      rule.rate = r.number("rate");
+    } else if (rule.motion != PrescribedMotion::Fixed) {
+      rule.value = r.vector<D>("value");
+    }
+    rule.ramp.duration = r.nonNegative("ramp", 0.0);
+    if (rule.motion != PrescribedMotion::Rotation) r.allow({"value"});
+    return motion;
+  }
+
+  static std::string motionText(const Prescription<D>& rule) {
+    return rule.motion == PrescribedMotion::Fixed ? ""
+           : rule.motion == PrescribedMotion::Rotation
+               ? rotationText<D>(rule.axis, rule.point, rule.rate)
+               : fmt<D>(rule.value);
   }
 
   void readPrescriptions() {
@@ -382,22 +483,7 @@ class Builder {
       Prescription<D> rule;
       rule.name = "prescribe." + name;
       rule.particles = region(r);
-      const std::string motion =
-          r.word("motion", "fixed", {"fixed", "velocity", "displacement", "rotation"});
-      rule.motion = motion == "fixed"          ? PrescribedMotion::Fixed
-                    : motion == "velocity"     ? PrescribedMotion::Velocity
-                    : motion == "displacement" ? PrescribedMotion::Displacement
-                                               : PrescribedMotion::Rotation;
-      if (rule.motion == PrescribedMotion::Rotation) {
-        // Rigid rotation about the axis through `point` at `rate` rad/s (times the ramp).
-        rule.axis = rotationAxis<D>(r);
-        rule.point = r.vector<D>("point");
-        rule.rate = r.number("rate");
-      } else if (rule.motion != PrescribedMotion::Fixed) {
-        rule.value = r.vector<D>("value");
-      }
-      rule.ramp.duration = r.nonNegative("ramp", 0.0);
-      if (rule.motion != PrescribedMotion::Rotation) r.allow({"value"});
+      const std::string motion = readMotion(r, rule);
       r.finish();
       for (Index i : rule.particles) {
         if (p.motion[i] == Motion::Prescribed)
@@ -406,10 +492,7 @@ class Builder {
                                       " is already prescribed by another condition");
         p.motion[i] = Motion::Prescribed;
       }
-      const std::string what = rule.motion == PrescribedMotion::Fixed ? ""
-                               : rule.motion == PrescribedMotion::Rotation
-                                   ? rotationText<D>(rule.axis, rule.point, rule.rate) + " "
-                                   : fmt<D>(rule.value) + " ";
+      const std::string what = rule.motion == PrescribedMotion::Fixed ? "" : motionText(rule) + " ";
       setup_.conditions.push_back(rule.name + ": " + motion + " " + what + "on " +
                                   std::to_string(rule.particles.size()) + " particles");
       setup_.scene.prescriptions.push_back(std::move(rule));
@@ -428,11 +511,28 @@ class Builder {
       SectionReader r(config_, "load." + name);
       Load<D> load;
       load.name = "load." + name;
+      const std::string regionName = r.has("region") ? config_.get("load." + name, "region") : "";
       load.particles = region(r);
+      std::string where = regionName.empty() ? "" : " of region '" + regionName + "'";
+      if (r.has("face")) {
+        // The surface layer of the bodies' face (as for clamps), within the region if given.
+        const std::string face = r.word("face", std::nullopt, faceNames());
+        std::vector<Index> onFace;
+        for (Index i : load.particles)
+          if (onBoundingFace(i, face)) onFace.push_back(i);
+        if (onFace.empty())
+          throw r.error("face", "the region '" + (regionName.empty() ? "all" : regionName) +
+                                    "' has no particle on face " + face +
+                                    " (the layer of particles at the bodies' extreme along " +
+                                    face + ")");
+        load.particles = std::move(onFace);
+        where = " on face " + face + where;
+      }
       const std::string type = r.word("type", std::nullopt, {"traction", "force"});
       const Vec<D> value = r.vector<D>("value");
       load.ramp.duration = r.nonNegative("ramp", 0.0);
       r.finish();
+      if (type == "traction") warnInteriorTraction(load, regionName);
       double volume = 0.0;
       for (Index i : load.particles)
         volume += p.volume[i];
@@ -443,7 +543,7 @@ class Builder {
         load.force.push_back(share * value);
       }
       setup_.conditions.push_back(load.name + ": " + type + " " + fmt<D>(value) + " on " +
-                                  std::to_string(load.particles.size()) + " particles");
+                                  std::to_string(load.particles.size()) + " particles" + where);
       setup_.scene.loads.push_back(std::move(load));
     }
   }
@@ -619,24 +719,11 @@ class Builder {
   }
 
   void rejectUnknownSections() {
-    static const std::vector<std::string> kinds = {"scene",
-                                                   "kernel",
-                                                   "hourglass",
-                                                   "time",
-                                                   "static",
-                                                   "damping",
-                                                   "gravity",
-                                                   "output",
-                                                   "material",
-                                                   "body",
-                                                   "region",
-                                                   "clamp",
-                                                   "prescribe",
-                                                   "load",
-                                                   "initial",
-                                                   "probe",
-                                                   "artificial_viscosity",
-                                                   "guard"};
+    static const std::vector<std::string> kinds = {
+        "scene",   "kernel",    "hourglass", "time",    "static", "damping",
+        "gravity", "output",    "material",  "body",    "hole",   "region",
+        "clamp",   "prescribe", "load",      "initial", "probe",  "artificial_viscosity",
+        "guard"};
     for (const auto& section : config_.sections()) {
       const std::string kind = section.substr(0, section.find('.'));
       if (std::find(kinds.begin(), kinds.end(), kind) != kinds.end()) continue;
@@ -648,6 +735,7 @@ class Builder {
 
   const Config& config_;
   SceneSetup<D> setup_;
+  Eigen::AlignedBox<double, D> bodyBox_;
   std::size_t maxParticles_ = 0;
   double supportRatio_ = 2.0;
   Index bodyCount_ = 0;

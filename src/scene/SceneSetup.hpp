@@ -65,6 +65,7 @@ struct SceneSetup {
   std::vector<std::uint8_t> ghost;         // per particle: 1 for clamp ghosts
   std::map<std::string, std::vector<Index>> regions;
   std::vector<std::string> conditions;  // one line per condition, for `tlsph check`
+  std::vector<std::string> warnings;    // scene problems that do not stop a run
 };
 
 }  // namespace tlsph

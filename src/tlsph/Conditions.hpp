@@ -88,14 +88,58 @@ struct Load {
   Ramp ramp;
 };
 
-// A ghost of a mirrored clamp (DESIGN.md section 3): its displacement is the odd reflection
-// u_ghost = -u_mirror of the body particle mirrored across the clamped face, so u = 0 on the
-// face to second order. It carries no strain energy of its own and its force goes back to the
-// mirror particle (the chain rule), which keeps the system conservative.
+// A ghost of a mirrored clamp (DESIGN.md section 3). Its displacement extrapolates the body's
+// across the clamped face so that u equals the face's prescribed displacement u_p there:
+//   u_ghost = u_p(X_ghost) + w1 (u_1 - u_p(X_1)) + w2 (u_2 - u_p(X_2)),
+// with particle 1 the body particle mirrored across the face and particle 2 the next one inward
+// on the same line (w2 = 0, second = -1: the odd reflection u_ghost = -u_mirror for a fixed
+// face). The ghost carries no strain energy of its own and its force goes back to particles 1
+// and 2 with the weights w1, w2 (the chain rule), which keeps the system conservative.
 struct MirrorGhost {
   Index ghost = 0;
-  Index mirror = 0;
+  Index mirror = 0;  // particle 1
+  double w1 = -1.0;
+  Index second = -1;  // particle 2, or -1
+  double w2 = 0.0;
+  int motion = -1;  // index into Scene::prescriptions of the face's motion; -1: held fixed
 };
+
+// Prescribed displacement and velocity of a rule at any reference point X (not only at its
+// particles), for faces whose ghosts follow the rule by reflection; a rule's particles start
+// from zero displacement here.
+template <int D>
+Vec<D> prescribedDisplacementAt(const Prescription<D>& rule, const Vec<D>& X, double t) {
+  switch (rule.motion) {
+    case PrescribedMotion::Fixed:
+      return Vec<D>::Zero();
+    case PrescribedMotion::Velocity:
+      return rule.value * rampedAngle(1.0, rule.ramp, t);  // integral of the ramp
+    case PrescribedMotion::Displacement:
+      return rule.value * rule.ramp.factor(t);
+    case PrescribedMotion::Rotation: {
+      const Mat<D> R = rotationMatrix<D>(rule.axis, rampedAngle(rule.rate, rule.ramp, t));
+      return Vec<D>(rule.point + R * (X - rule.point) - X);
+    }
+  }
+  return Vec<D>::Zero();
+}
+
+template <int D>
+Vec<D> prescribedVelocityAt(const Prescription<D>& rule, const Vec<D>& X, double t) {
+  switch (rule.motion) {
+    case PrescribedMotion::Fixed:
+      return Vec<D>::Zero();
+    case PrescribedMotion::Velocity:
+      return rule.value * rule.ramp.factor(t);
+    case PrescribedMotion::Displacement:
+      return rule.value * rule.ramp.rate(t);
+    case PrescribedMotion::Rotation: {
+      const Vec<D> r = X + prescribedDisplacementAt(rule, X, t) - rule.point;
+      return rotationVelocity<D>(rule.axis, rule.rate * rule.ramp.factor(t), r);
+    }
+  }
+  return Vec<D>::Zero();
+}
 
 struct Damping {
   double viscous = 0.0;  // mass-proportional coefficient c [1/s]: f = -c m v

@@ -80,6 +80,10 @@ class Solver {
       external_.assign(p.size(), Vec<D>::Zero());
       computeExternalForces(0.0);
     }
+    for (const auto& m : scene.mirrorGhosts)
+      if (m.motion >= 0 && scene.prescriptions[m.motion].motion != PrescribedMotion::Fixed)
+        movingMirrors_ = true;
+    mirrorDrive(0.0, drive_, &driveRate_);
     mirrorGhostMotion();
     forces_.compute(scene.particles.displacement, scene.particles.force, &scene.particles.velocity);
     chainMirrorForces();
@@ -132,10 +136,22 @@ class Solver {
     }
 
     time_ += dt_;
+    // A moving mirrored face does work -f_ghost . (change of the ghost's prescribed part).
+    std::vector<Vec<D>> driveStep;
+    if (movingMirrors_) {
+      driveStep = drive_;
+      mirrorDrive(time_, drive_, &driveRate_);
+      for (std::size_t k = 0; k < drive_.size(); ++k) {
+        driveStep[k] = drive_[k] - driveStep[k];
+        boundaryWork -= 0.5 * p.force[scene_.mirrorGhosts[k].ghost].dot(driveStep[k]);
+      }
+    }
     mirrorGhostMotion();
     // The artificial viscosity sees the mid-step velocities.
     forces_.compute(p.displacement, p.force, &p.velocity);
     chainMirrorForces();
+    for (std::size_t k = 0; k < driveStep.size(); ++k)
+      boundaryWork -= 0.5 * p.force[scene_.mirrorGhosts[k].ghost].dot(driveStep[k]);
     if (hasExternal_) computeExternalForces(time_);
 
     double kinetic = 0.0;
@@ -218,6 +234,21 @@ class Solver {
     return end;
   }
 
+  // Force that prescription r (a clamp or a prescribed region) exerts on the rest of the
+  // system: minus the internal force on its prescribed particles, and for the mirrored ghosts
+  // that follow it, the net force the chain rule leaves on the body, -(1 - w1 - w2) f_ghost
+  // (the internal forces of all particles sum to zero). In equilibrium the reactions balance
+  // the loads.
+  Vec<D> reaction(std::size_t r) const {
+    const auto& p = scene_.particles;
+    Vec<D> R = Vec<D>::Zero();
+    for (Index i : scene_.prescriptions.at(r).particles)
+      R -= p.force[i];
+    for (const auto& m : scene_.mirrorGhosts)
+      if (m.motion == static_cast<int>(r)) R -= (1.0 - m.w1 - m.w2) * p.force[m.ghost];
+    return R;
+  }
+
   // Recomputes the forces (and the external forces at the current time) for the particles'
   // present displacements and velocities, without advancing: for a state put back from a
   // copy, e.g. to write the last good frame of a run that went unstable.
@@ -234,12 +265,18 @@ class Solver {
     const auto& p = scene.particles;
     std::vector<Index> ghosts;
     std::vector<std::uint8_t> listed(p.size(), 0);
+    auto freeParticle = [&](Index i) {
+      return i >= 0 && i < p.size() && p.motion[i] == Motion::Free;
+    };
     for (const auto& m : scene.mirrorGhosts) {
-      if (m.ghost < 0 || m.ghost >= p.size() || m.mirror < 0 || m.mirror >= p.size() ||
-          p.motion[m.ghost] != Motion::Mirrored || p.motion[m.mirror] != Motion::Free)
+      if (m.ghost < 0 || m.ghost >= p.size() || p.motion[m.ghost] != Motion::Mirrored ||
+          !freeParticle(m.mirror) || (m.second >= 0 && !freeParticle(m.second)))
         throw SetupError("mirror ghost " + std::to_string(m.ghost) + " of particle " +
                          std::to_string(m.mirror) +
-                         " must be a mirrored particle whose mirror is a free one");
+                         " must be a mirrored particle whose mirror particles are free ones");
+      if (m.motion >= static_cast<int>(scene.prescriptions.size()))
+        throw SetupError("mirror ghost " + std::to_string(m.ghost) + " names motion rule " +
+                         std::to_string(m.motion) + ", which does not exist");
       listed[m.ghost] = 1;
       ghosts.push_back(m.ghost);
     }
@@ -249,22 +286,58 @@ class Solver {
     return ghosts;
   }
 
-  // u_ghost = -u_mirror, v_ghost = -v_mirror: the odd reflection across the clamped face.
-  void mirrorGhostMotion() {
-    auto& p = scene_.particles;
-    for (const auto& m : scene_.mirrorGhosts) {
-      p.displacement[m.ghost] = -p.displacement[m.mirror];
-      p.velocity[m.ghost] = -p.velocity[m.mirror];
+  // The prescribed part of each mirrored ghost's displacement at time t,
+  //   d_g = u_p(X_g) - w1 u_p(X_1) - w2 u_p(X_2)   (MirrorGhost), and its rate;
+  // empty when every mirrored face is held fixed (then d_g = 0).
+  void mirrorDrive(double t, std::vector<Vec<D>>& drive, std::vector<Vec<D>>* rate) const {
+    if (!movingMirrors_) return;
+    const auto& X = scene_.particles.referencePosition;
+    const auto n = scene_.mirrorGhosts.size();
+    drive.assign(n, Vec<D>::Zero());
+    if (rate) rate->assign(n, Vec<D>::Zero());
+    for (std::size_t k = 0; k < n; ++k) {
+      const auto& m = scene_.mirrorGhosts[k];
+      if (m.motion < 0) continue;
+      const auto& rule = scene_.prescriptions[m.motion];
+      drive[k] = prescribedDisplacementAt(rule, X[m.ghost], t) -
+                 m.w1 * prescribedDisplacementAt(rule, X[m.mirror], t);
+      if (m.second >= 0) drive[k] -= m.w2 * prescribedDisplacementAt(rule, X[m.second], t);
+      if (rate) {
+        (*rate)[k] = prescribedVelocityAt(rule, X[m.ghost], t) -
+                     m.w1 * prescribedVelocityAt(rule, X[m.mirror], t);
+        if (m.second >= 0) (*rate)[k] -= m.w2 * prescribedVelocityAt(rule, X[m.second], t);
+      }
     }
   }
 
-  // The chain rule of u_ghost = -u_mirror: -dE/du_mirror gains -(-dE/du_ghost). The ghost
-  // keeps its own force as the clamp's reaction (for reports). Serial: two faces' ghosts can
-  // share a mirror particle.
+  // u_ghost = d_g + w1 u_1 + w2 u_2, the same for v: the ghosts extrapolate the body across
+  // the face (MirrorGhost).
+  void mirrorGhostMotion() {
+    auto& p = scene_.particles;
+    for (std::size_t k = 0; k < scene_.mirrorGhosts.size(); ++k) {
+      const auto& m = scene_.mirrorGhosts[k];
+      p.displacement[m.ghost] = m.w1 * p.displacement[m.mirror];
+      p.velocity[m.ghost] = m.w1 * p.velocity[m.mirror];
+      if (m.second >= 0) {
+        p.displacement[m.ghost] += m.w2 * p.displacement[m.second];
+        p.velocity[m.ghost] += m.w2 * p.velocity[m.second];
+      }
+      if (movingMirrors_) {
+        p.displacement[m.ghost] += drive_[k];
+        p.velocity[m.ghost] += driveRate_[k];
+      }
+    }
+  }
+
+  // The chain rule of the ghost's extrapolation: -dE/du_1 gains w1 (-dE/du_ghost), -dE/du_2
+  // gains w2 (-dE/du_ghost). The ghost keeps its own force, from which reaction() is computed.
+  // Serial: two faces' ghosts can share a mirror particle.
   void chainMirrorForces() {
     auto& p = scene_.particles;
-    for (const auto& m : scene_.mirrorGhosts)
-      p.force[m.mirror] -= p.force[m.ghost];
+    for (const auto& m : scene_.mirrorGhosts) {
+      p.force[m.mirror] += m.w1 * p.force[m.ghost];
+      if (m.second >= 0) p.force[m.second] += m.w2 * p.force[m.ghost];
+    }
   }
 
   static Kernel<D> checkedKernel(const Scene<D>& scene) {
@@ -342,6 +415,8 @@ class Solver {
   std::vector<Vec<D>> step_;   // per prescribed particle: its displacement over this step
   std::vector<Vec<D>> external_;
   bool hasExternal_ = false;
+  bool movingMirrors_ = false;             // some mirrored face follows a moving prescription
+  std::vector<Vec<D>> drive_, driveRate_;  // per mirrored ghost: prescribed part of u and v
   StableStep stable_;
   double dt_ = 0.0;
   double time_ = 0.0;
