@@ -186,8 +186,28 @@ TEST(SceneInput, BadClampMethodAndFace) {
       replaced(kGood, "lower = 0.19 0\nupper = 0.2 0.04", "lower = 0.02 0\nupper = 0.03 0.04"),
       "upper = 0.2 0.04", "upper = 0.03 0.04");
   EXPECT_EQ(errorOf(thin), "");  // three layers: enough for the odd reflection
-  expectError(errorOf(replaced(thin, "face = x-", "face = x-\nmethod = mirror-quadratic")),
-              {"[clamp.root]", "method", "thinner than 4 layers", "method = fixed"});
+}
+
+// Where the body is too thin behind a mirrored face, the ghosts fall back (a warning says
+// how many): to the odd reflection without a second layer, to fixed ghosts without a mirror.
+TEST(SceneInput, ThinBodyBehindAMirroredFaceFallsBack) {
+  const std::string thin = replaced(
+      replaced(kGood, "lower = 0.19 0\nupper = 0.2 0.04", "lower = 0.01 0\nupper = 0.02 0.04"),
+      "upper = 0.2 0.04", "upper = 0.02 0.04");  // two layers behind x-
+  const SceneSetup<2> odd = buildScene<2>(Config::parse(thin, "scene.ini"));
+  ASSERT_EQ(odd.warnings.size(), 1u);
+  EXPECT_NE(odd.warnings[0].find("4 of the 12 ghosts have no body particle to mirror"),
+            std::string::npos)
+      << odd.warnings[0];
+  EXPECT_EQ(odd.scene.mirrorGhosts.size(), 8u);
+  ASSERT_EQ(odd.scene.prescriptions.size(), 1u);
+  EXPECT_EQ(odd.scene.prescriptions[0].particles.size(), 4u);  // layer-3 ghosts held fixed
+
+  const SceneSetup<2> quadratic = buildScene<2>(Config::parse(
+      replaced(thin, "face = x-", "face = x-\nmethod = mirror-quadratic"), "scene.ini"));
+  ASSERT_EQ(quadratic.warnings.size(), 2u);
+  EXPECT_NE(quadratic.warnings[1].find("4 ghosts have no second body layer"), std::string::npos)
+      << quadratic.warnings[1];
 }
 
 TEST(SceneInput, MovingClampIsAPrescriptionFollowedByItsGhosts) {

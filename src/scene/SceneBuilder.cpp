@@ -395,40 +395,45 @@ class Builder {
       const bool quadratic = method == "mirror-quadratic";
       const int rule = static_cast<int>(setup_.scene.prescriptions.size());
       const double V = std::pow(setup_.dx, D);
-      Index ghosts = 0;
+      Index ghosts = 0, fixedFallback = 0, oddFallback = 0;
+      Vec<D> thinAt = Vec<D>::Zero();
       for (Index i = 0; i < bodyCount_; ++i) {
         if (!onBoundingFace(i, face)) continue;
         for (long k = 1; k <= layers; ++k) {
           Vec<D> G = X[i];
           G[axis] += sign * k * setup_.dx;
+          // Ghost layer k mirrors body layer k across the face (half a spacing outside X_i);
+          // the quadratic extrapolation also uses body layer k + 1 (MirrorGhost). Where the
+          // body is too thin behind the face (a wedge's tip), the ghost falls back to the
+          // odd reflection, or, with no body particle to mirror at all, is held as a fixed
+          // ghost that follows the clamp's motion.
           MirrorGhost m;
+          bool mirrored = false;
           if (mirror) {
-            // Ghost layer k mirrors body layer k across the face (half a spacing outside X_i);
-            // the quadratic extrapolation also uses body layer k + 1 (MirrorGhost).
-            const long needed = quadratic ? k + 1 : k;
-            for (long l = k; l <= needed; ++l) {
+            auto behind = [&](long l) {
               Vec<D> M = X[i];
               M[axis] -= sign * (l - 1) * setup_.dx;
-              const Index image = latticeParticle(M);
-              if (image < 0)
-                throw r.error("method", "the body is thinner than " + std::to_string(needed) +
-                                            " layers behind face " + face + " at (" + fmt<D>(M) +
-                                            "): method = " + method +
-                                            " needs a body particle there; use method = "
-                                            "fixed");
-              (l == k ? m.mirror : m.second) = image;
+              return latticeParticle(M);
+            };
+            m.mirror = behind(k);
+            mirrored = m.mirror >= 0;
+            if (mirrored && quadratic) {
+              m.second = behind(k + 1);
+              if (m.second >= 0) {
+                // Lagrange extrapolation through u_p on the face, body layers k and k + 1.
+                m.w1 = -2.0 * k;
+                m.w2 = (2.0 * k - 1.0) * (2.0 * k - 1.0) / (2.0 * k + 1.0);
+              } else {
+                ++oddFallback;
+              }
             }
-            if (quadratic) {
-              // Lagrange extrapolation through u_p on the face, body layers k and k + 1.
-              m.w1 = -2.0 * k;
-              m.w2 = (2.0 * k - 1.0) * (2.0 * k - 1.0) / (2.0 * k + 1.0);
-            }
+            if (!mirrored && fixedFallback++ == 0) thinAt = X[i];
             m.motion = rule;
           }
           const std::uint16_t mat = p.material[i];
           const Index g = p.add(G, V, density(setup_.scene.materials[mat]) * V, mat,
-                                mirror ? Motion::Mirrored : Motion::Prescribed);
-          if (mirror) {
+                                mirrored ? Motion::Mirrored : Motion::Prescribed);
+          if (mirrored) {
             m.ghost = g;
             setup_.scene.mirrorGhosts.push_back(m);
           } else {
@@ -443,7 +448,21 @@ class Builder {
           "clamp." + name + ": face " + face + ", " + method + ", " +
           (motion == "fixed" ? "" : motion + " " + motionText(clamp) + ", ") +
           std::to_string(layers) + " ghost layers, " + std::to_string(ghosts) + " ghost particles");
-      // A mirrored clamp's rule has no particles: its ghosts follow it by reflection.
+      if (fixedFallback > 0)
+        setup_.warnings.push_back(
+            config_.where("clamp." + name, "method") + ": [clamp." + name + "] " +
+            std::to_string(fixedFallback) + " of the " + std::to_string(ghosts) +
+            " ghosts have no body particle to mirror (the body is thinner than " +
+            std::to_string(layers) + " layers behind face " + face + ", e.g. behind " +
+            fmt<D>(thinAt) + "); they are held as fixed ghosts (method = fixed there), which " +
+            "puts u = 0 dx/2 outside the face at those points");
+      if (oddFallback > 0)
+        setup_.warnings.push_back(config_.where("clamp." + name, "method") + ": [clamp." + name +
+                                  "] " + std::to_string(oddFallback) +
+                                  " ghosts have no second body layer behind their mirror "
+                                  "particle; they take the odd reflection (method = mirror)");
+      // A mirrored clamp's rule holds its fixed-ghost fallbacks only: the other ghosts follow
+      // it by reflection.
       setup_.scene.prescriptions.push_back(std::move(clamp));
     }
   }
