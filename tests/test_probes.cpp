@@ -29,7 +29,7 @@ end = 0.01
 [probe.tip]
 point = 0.2 0.02
 method = kernel
-quantities = displacement velocity
+quantities = displacement velocity cauchy_stress
 [probe.corner]
 point = 0.2 0.04
 method = kernel
@@ -71,4 +71,19 @@ TEST(Probes, KernelProbeIsExactForAffineFieldsAtSurfacePoints) {
   const double nearX = value("near_ux");
   const Vec<2> a = c + G * Vec<2>(0.195, 0.015), b = c + G * Vec<2>(0.195, 0.025);
   EXPECT_TRUE(std::abs(nearX - a.x()) < 1e-14 || std::abs(nearX - b.x()) < 1e-14) << nearX;
+
+  // A homogeneous deformation: every particle has the same F, so the stress probe is the
+  // material's Cauchy stress for that F (plane strain: sigma_zz included, no xz, yz).
+  const Mat3 F3 = embedDeformationGradient<2>(Mat<2>::Identity() + G);
+  const Mat3 P = std::visit([&](const auto& m) { return m.firstPiolaKirchhoff(F3); },
+                            setup.scene.materials[0]);
+  const Mat3 sigma = P * F3.transpose() / F3.determinant();
+  const double scale = sigma.norm();
+  EXPECT_NEAR(value("tip_sxx"), sigma(0, 0), 1e-12 * scale);
+  EXPECT_NEAR(value("tip_syy"), sigma(1, 1), 1e-12 * scale);
+  EXPECT_NEAR(value("tip_szz"), sigma(2, 2), 1e-12 * scale);
+  EXPECT_NEAR(value("tip_sxy"), sigma(0, 1), 1e-12 * scale);
+  EXPECT_NEAR(value("tip_syz"), 0.0, 1e-12 * scale);
+  EXPECT_NEAR(value("tip_sxz"), 0.0, 1e-12 * scale);
+  EXPECT_GT(std::abs(sigma(2, 2)), 1e-3 * scale);
 }

@@ -34,6 +34,15 @@ std::vector<double> hourglassError(const ReferenceConfiguration<D>& ref,
   return out;
 }
 
+// The full 3D Cauchy stress sigma = P F^T / J of particle i (in plane strain with sigma_33).
+template <int D>
+Mat3 cauchyStressOf(const SceneSetup<D>& setup, const Mat<D>& F, Index i) {
+  const Mat3 F3 = embedDeformationGradient<D>(F);
+  const Mat3 P = std::visit([&](const auto& model) { return model.firstPiolaKirchhoff(F3); },
+                            setup.scene.materials[setup.scene.particles.material[i]]);
+  return P * F3.transpose() / F3.determinant();
+}
+
 // Every field name makeFrame knows, in the order of docs/scene-format.md ([output] fields).
 inline const std::vector<std::string>& allFrameFields() {
   static const std::vector<std::string> names = {"displacement",    "velocity",      "J",

@@ -50,9 +50,15 @@ std::vector<std::string> probeColumns(const SceneSetup<D>& setup) {
   std::vector<std::string> columns = {"time", "step"};
   const char* axes = "xyz";
   for (const auto& probe : setup.probes)
-    for (const auto& q : probe.quantities)
+    for (const auto& q : probe.quantities) {
+      if (q == "cauchy_stress") {
+        for (const char* c : {"xx", "yy", "zz", "xy", "yz", "xz"})
+          columns.push_back(probe.name + "_s" + c);
+        continue;
+      }
       for (int a = 0; a < D; ++a)
         columns.push_back(probe.name + "_" + (q == "displacement" ? "u" : "v") + axes[a]);
+    }
   return columns;
 }
 
@@ -63,6 +69,14 @@ std::vector<double> probeRow(const SceneSetup<D>& setup, const Solver<D>& solver
   std::vector<double> row = {solver.time(), double(solver.stepCount())};
   for (const auto& probe : setup.probes)
     for (const auto& q : probe.quantities) {
+      if (q == "cauchy_stress") {
+        // The weighted particle stresses (Shepard; the probe's weights), xx yy zz xy yz xz.
+        Mat3 s = Mat3::Zero();
+        for (std::size_t k = 0; k < probe.particles.size(); ++k)
+          s += probe.weights[k] * cauchyStressOf(setup, F[probe.particles[k]], probe.particles[k]);
+        row.insert(row.end(), {s(0, 0), s(1, 1), s(2, 2), s(0, 1), s(1, 2), s(0, 2)});
+        continue;
+      }
       const bool displacement = q == "displacement";
       const auto& field = displacement ? p.displacement : p.velocity;
       const bool firstOrder = displacement && !probe.offsets.empty();

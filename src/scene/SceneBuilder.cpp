@@ -701,9 +701,9 @@ class Builder {
                          : ProbeMethod::Kernel;
       probe.quantities = r.words("quantities", {"displacement"});
       for (const auto& q : probe.quantities)
-        if (q != "displacement" && q != "velocity")
-          throw r.error("quantities",
-                        "unknown quantity '" + q + "'; expected displacement, velocity");
+        if (q != "displacement" && q != "velocity" && q != "cauchy_stress")
+          throw r.error("quantities", "unknown quantity '" + q +
+                                          "'; expected displacement, velocity, cauchy_stress");
       r.finish();
       if (probe.method == ProbeMethod::Nearest) {
         Index best = 0;
