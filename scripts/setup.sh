@@ -25,6 +25,10 @@ packages=(cmake make g++ libeigen3-dev libboost-program-options-dev libvtk9-dev
 if [ "$action" = validate ] || [ "$action" = stability ]; then
   packages+=(python3-numpy python3-matplotlib)
 fi
+# The FEM references of the validation (validation/fem.py) are computed with CalculiX.
+if [ "$action" = validate ]; then
+  packages+=(calculix-ccx)
+fi
 
 missing=()
 for pkg in "${packages[@]}"; do
