@@ -21,7 +21,11 @@ jobs="${JOBS:-$(nproc)}"
 
 packages=(cmake make g++ libeigen3-dev libboost-program-options-dev libvtk9-dev
   libgtest-dev googletest python3)
-# The validation report's plots need numpy and matplotlib (the quick check under ctest does not).
+# The validation report's plots need numpy and matplotlib (the quick check under ctest does not;
+# the FEM VTU self-test under ctest needs numpy).
+if [ "$action" = test ]; then
+  packages+=(python3-numpy)
+fi
 if [ "$action" = validate ] || [ "$action" = stability ]; then
   packages+=(python3-numpy python3-matplotlib)
 fi
