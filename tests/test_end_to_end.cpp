@@ -67,10 +67,22 @@ TEST_F(EndToEnd, CantileverConvergesOnTimoshenkoDeflection) {
   EXPECT_NE(r.output.find("converged"), std::string::npos) << r.output;
   const auto row = lastRow(dir_ / "probes.csv");
   const double tip = -row.at("tip_uz");
-  const double timoshenko = 0.01516, fem = 0.01501;
+  // Converged CalculiX C3D20R of the same beam, face x = 0 clamped (validation/fem/
+  // references.json, Richardson of 10x1x1 .. 80x8x8); tlsph at this resolution (8 through)
+  // measured +1.6 % (validation/report), converging at order 1.8-1.9.
+  const double timoshenko = 0.01516, fem = 0.015022;
   std::cout << "cantilever tip deflection " << tip << " m (Timoshenko " << timoshenko << ", FEM "
-            << fem << "): " << 100 * (tip - timoshenko) / timoshenko << " %\n";
+            << fem << "): " << 100 * (tip - fem) / fem << " % against the FEM\n";
   EXPECT_NEAR(tip, timoshenko, 0.05 * timoshenko);
+  EXPECT_GT(tip, fem);
+  EXPECT_LT(tip, 1.02 * fem);
+
+  // The clamp's reaction balances the beam's weight, 1000 kg/m^3 x 0.01 m^2 x 1 m x 1 m/s^2,
+  // to the static tolerance (1e-5 of the out-of-balance force).
+  const auto reaction = lastRow(dir_ / "reactions.csv");
+  EXPECT_NEAR(reaction.at("clamp.root_z"), 10.0, 1e-3);
+  EXPECT_NEAR(reaction.at("clamp.root_x"), 0.0, 1e-3);
+  EXPECT_NEAR(reaction.at("clamp.root_y"), 0.0, 1e-3);
 
   // The .pvd and its last frame, read back with VTK.
   const fs::path pvd = dir_ / "cantilever.pvd";
