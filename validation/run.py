@@ -16,7 +16,13 @@ From the repository root (the build must exist: `bash scripts/setup.sh build`):
 Each run is `build/tlsph run validation/scenes/<problem>.ini --output.directory=<runs>/<id>
 --output.fields=none --no-progress [overrides]` with OMP_NUM_THREADS = --threads (default: all
 cores), one after the other. The runner reads the run's summary.json and probes.csv, extracts
-the quantity of interest, and compares it with the reference (validation/references.py). Every
+the quantity of interest, and compares it with the reference (validation/references.py, and
+the CalculiX solutions of validation/fem.py read from validation/fem/references.json: the
+converged value, i.e. the Richardson estimate where the FEM mesh ladder converges
+monotonically, else the finest mesh). The full validation first regenerates those FEM
+references (validation/fem.py, needs ccx and numpy; --no-fem keeps the committed ones), and
+compares the final frame of every static ladder run that has an FEM solution field by field
+(`tlsph compare RUN validation/fem/out/CASE.vtu`: displacement and stress error norms). Every
 run's record (particles, neighbours, steps, dt, wall time, threads, git commit, the command
 that reproduces it, outcome, quantities, errors) goes to validation/report/results.json;
 validation/report/README.md and the PNG plots are made from that file (numpy and matplotlib
@@ -47,8 +53,93 @@ import references as refs  # noqa: E402
 # References
 
 
-def compute_references():
-    """Reference numbers (DESIGN.md section 6 and the sources cited in the scene files)."""
+FEM_JSON = HERE / "fem" / "references.json"  # validation/fem.py's point values (committed)
+FEM_OUT = HERE / "fem" / "out"  # its VTU files (git-ignored), for `tlsph compare`
+
+# The FEM case (validation/fem.py CASES) of each problem that has one, and whether its VTU is
+# compared field by field with the run's final frame (static problems only: a dynamic run's
+# last frame is not the equilibrium).
+FEM_CASE = {"cantilever_static": "cantilever", "cantilever_dynamic": "cantilever",
+            "clamped_plate": "clamped_plate", "cantilever_large": "cantilever_large",
+            "cook_membrane": "cook_membrane",
+            "cook_membrane_incompressible": "cook_membrane_incompressible",
+            "plate_hole": "plate_hole"}
+FIELD_PROBLEMS = ["cantilever_static", "clamped_plate", "cantilever_large", "cook_membrane",
+                  "cook_membrane_incompressible", "plate_hole"]
+
+
+def fem_vtu(case):
+    """The VTU validation/fem.py writes for a case's reference series (finest mesh)."""
+    return FEM_OUT / ("%s.vtu" % case)
+
+
+def load_fem_references(path=FEM_JSON):
+    """validation/fem/references.json (plain json: the quick check has no numpy)."""
+    try:
+        return json.loads(Path(path).read_text())
+    except (OSError, ValueError) as e:
+        raise SystemExit("cannot read the FEM references %s (%s): run "
+                         "`/usr/bin/python3 validation/fem.py` (needs ccx) or restore the "
+                         "committed file" % (rel(path), e))
+
+
+def fem_point(fem, case, key):
+    """(converged, finest) of an FEM point value: converged = the Richardson estimate of the
+    case's reference series where its last three meshes converge monotonically, else the
+    finest mesh's value."""
+    try:
+        ref = fem["cases"][case]["reference"]
+        finest = ref["values"][key]
+    except (KeyError, TypeError):
+        raise SystemExit("the FEM references %s have no value %s of case %s: run "
+                         "`/usr/bin/python3 validation/fem.py --case %s`"
+                         % (rel(FEM_JSON), key, case, case))
+    rich = (ref.get("richardson") or {}).get(key)
+    return (rich if rich is not None else finest), finest
+
+
+def fem_summary(fem, cases):
+    """What the references of `cases` are: mesh, ccx version, which values are Richardson."""
+    out = {}
+    for case in cases:
+        rec = fem["cases"].get(case)
+        if not rec:
+            out[case] = {"missing": True}
+            continue
+        ref = rec["reference"]
+        out[case] = {"series": ref.get("series"), "finest_mesh": ref.get("mesh"),
+                     "main": ref.get("main"), "ccx_version": rec.get("ccx_version"),
+                     "richardson": sorted((ref.get("richardson") or {}).keys()),
+                     "vtu": rel(fem_vtu(case)), "vtu_exists": fem_vtu(case).exists()}
+    return out
+
+
+def fem_order(fem, case, key):
+    """Observed order of the FEM reference series' last three meshes (None if not monotone)."""
+    try:
+        rec = fem["cases"][case]
+        conv = rec["series"][rec["reference"]["series"]]["convergence"][key]
+        return conv.get("observed_order")
+    except (KeyError, TypeError):
+        return None
+
+
+def fem_meshes(fem, case):
+    try:
+        rec = fem["cases"][case]
+        return [r["mesh"] for r in rec["series"][rec["reference"]["series"]]["runs"]]
+    except (KeyError, TypeError):
+        return []
+
+
+def _fem_mesh(fem, case):
+    return ((fem.get("cases", {}).get(case) or {}).get("reference") or {}).get("mesh")
+
+
+def compute_references(fem_path=FEM_JSON):
+    """Reference numbers (DESIGN.md section 6, the sources cited in the scene files, and the
+    CalculiX models of validation/fem.py read from validation/fem/references.json)."""
+    fem = load_fem_references(fem_path)
     r = {}
     # Oscillating plate (Gray, Monaghan & Swift 2001), plane strain.
     E, nu, rho, H, L = 2.0e6, 0.3975, 1000.0, 0.02, 0.2
@@ -68,11 +159,18 @@ def compute_references():
     E, nu, rho, b, L = 1.0e7, 0.3, 1000.0, 0.1, 1.0
     A, I = b * b, b**4 / 12.0
     q = rho * 1.0 * A
+    tip_fem, tip_fem_finest = fem_point(fem, "cantilever", "tip_deflection")
     r["cantilever"] = {
         "tip_timoshenko": 0.01516,
         "tip_timoshenko_computed": refs.timoshenko_static_tip(q, E, nu, A, I, L),
         "tip_euler_bernoulli": q * L**4 / (8 * E * I),
-        "tip_fem": 0.01501,
+        # CalculiX C3D20R, the whole face x = 0 clamped (validation/fem.py case cantilever):
+        # the converged value (Richardson) and the finest mesh's
+        "tip_fem": tip_fem,
+        "tip_fem_finest": tip_fem_finest,
+        "tip_fem_mesh": _fem_mesh(fem, "cantilever"),
+        "tip_fem_meshes": fem_meshes(fem, "cantilever"),
+        "tip_fem_order": fem_order(fem, "cantilever", "tip_deflection"),
         "f_euler_bernoulli": refs.euler_bernoulli_frequency(E, I, rho, A, L),
         "f_timoshenko": refs.timoshenko_frequency(E, nu, rho, A, I, L),
         "f_timoshenko_no_rotary": refs.timoshenko_frequency(E, nu, rho, A, I, L,
@@ -85,15 +183,53 @@ def compute_references():
                  "uy_amp": 6.5541e-2, "frequency": 1.0995}
     # Clamped square plate.
     E, nu, t, a, qp = 1.0e7, 0.3, 0.05, 0.5, 1000.0
+    w_fem, w_fem_finest = fem_point(fem, "clamped_plate", "centre_deflection")
+    prev = (((fem["cases"].get("clamped_plate") or {}).get("series") or {})
+            .get("previous_reference") or {}).get("runs")
     r["clamped_plate"] = {
         "w_kirchhoff": refs.kirchhoff_plate_deflection(E, nu, t, a, qp),
         "kirchhoff_coefficient_ritz": refs.kirchhoff_clamped_square(nu, n=6),
         "w_mindlin": refs.mindlin_clamped_square(E, nu, t, a, qp, n=6),
-        # CalculiX C3D20R, 40 x 40 x 4 elements, the four side faces clamped in every
-        # direction (DESIGN.md section 6); 20 x 20 x 4 gives 0.8110e-3.
-        "w_fem": 0.8121e-3,
-        "w_fem_coarse": 0.8110e-3,
+        # CalculiX C3D20R, the four side faces clamped in every direction (validation/fem.py
+        # case clamped_plate): converged (Richardson of the uniform ladder) and finest mesh
+        "w_fem": w_fem,
+        "w_fem_finest": w_fem_finest,
+        "w_fem_mesh": _fem_mesh(fem, "clamped_plate"),
+        "w_fem_meshes": fem_meshes(fem, "clamped_plate"),
+        "w_fem_order": fem_order(fem, "clamped_plate", "centre_deflection"),
+        # the earlier reference (DESIGN.md section 6), 40 x 40 x 4 elements
+        "w_fem_previous": prev[0]["values"]["centre_deflection"] if prev else 0.8121e-3,
     }
+    # Cantilever under g = 30: Saint Venant-Kirchhoff, NLGEOM.
+    c = {"mesh": _fem_mesh(fem, "cantilever_large"),
+         "meshes": fem_meshes(fem, "cantilever_large")}
+    for k in ("tip_uz", "tip_ux"):
+        c[k + "_fem"], c[k + "_fem_finest"] = fem_point(fem, "cantilever_large", k)
+        c[k + "_fem_order"] = fem_order(fem, "cantilever_large", k)
+    c["tip_uz_linear"] = -30.0 * tip_fem
+    r["cantilever_large"] = c
+    # Cook's membrane, plane strain, nu = 0.3 and 0.4999.
+    for case in ("cook_membrane", "cook_membrane_incompressible"):
+        c = {"mesh": _fem_mesh(fem, case), "meshes": fem_meshes(fem, case)}
+        for k in ("corner_uy", "corner_ux", "edge_mid_uy"):
+            c[k + "_fem"], c[k + "_fem_finest"] = fem_point(fem, case, k)
+            c[k + "_fem_order"] = fem_order(fem, case, k)
+        r[case] = c
+    # Plate with a hole, plane strain.
+    c = {"mesh": _fem_mesh(fem, "plate_hole"), "meshes": fem_meshes(fem, "plate_hole")}
+    for k in ("kt_top", "end_ux"):
+        c[k + "_fem"], c[k + "_fem_finest"] = fem_point(fem, "plate_hole", k)
+        c[k + "_fem_order"] = fem_order(fem, "plate_hole", k)
+    an = fem["cases"]["plate_hole"].get("analytic") or {}  # fem_point checked the case
+    c["kt_peterson"] = an.get("peterson_gross")
+    c["kt_heywood"] = an.get("heywood_gross")
+    c["traction"] = 1.0e5
+    r["plate_hole"] = c
+    r["fem"] = {"references": rel(fem_path), "generator": fem.get("generator"),
+                "ccx_version": fem.get("ccx_version"),
+                "value_used": "Richardson estimate of the reference series where its last three "
+                              "meshes converge monotonically, else the finest mesh",
+                "cases": fem_summary(fem, sorted(set(FEM_CASE.values())))}
     return r
 
 
@@ -205,6 +341,15 @@ def pct(value, reference):
     return 100.0 * (value - reference) / abs(reference)
 
 
+def pct_along(value, reference):
+    """Signed % error of a displacement component relative to the reference's direction:
+    positive = larger than the reference in its own direction (too soft), whatever the
+    component's sign."""
+    if value is None or reference is None or not math.isfinite(value):
+        return None
+    return 100.0 * (value - reference) / reference
+
+
 # --------------------------------------------------------------------------------------------
 # Quantities of interest. Each extractor returns {"values": {...}, "errors": {...} (signed %),
 # "primary": name of the error that is the problem's headline, "notes": [...]}.
@@ -234,10 +379,12 @@ def extract_cantilever_static(series, summary, R):
     w95, w90 = -series["x095_uz"][-1], -series["x090_uz"][-1]
     w_ex = 2 * w95 - w90
     return {"values": {"tip": w, "tip_extrapolated": w_ex, "tip_ux": series["tip_ux"][-1]},
-            "errors": {"tip": pct(w, ref["tip_timoshenko"]),
-                       "tip_vs_fem": pct(w, ref["tip_fem"]),
+            "errors": {"tip_vs_fem": pct(w, ref["tip_fem"]),
+                       "tip": pct(w, ref["tip_timoshenko"]),
+                       "tip_vs_fem_finest": pct(w, ref["tip_fem_finest"]),
+                       "tip_extrapolated_vs_fem": pct(w_ex, ref["tip_fem"]),
                        "tip_extrapolated": pct(w_ex, ref["tip_timoshenko"])},
-            "primary": "tip"}
+            "primary": "tip_vs_fem"}
 
 
 def extract_cantilever_dynamic(series, summary, R):
@@ -342,9 +489,50 @@ def extract_clamped_plate(series, summary, R):
     ref = R["clamped_plate"]
     w = -series["centre_uz"][-1]
     return {"values": {"w": w},
-            "errors": {"w": pct(w, ref["w_kirchhoff"]), "w_vs_mindlin": pct(w, ref["w_mindlin"]),
-                       "w_vs_fem": pct(w, ref["w_fem"])},
+            "errors": {"w_vs_fem": pct(w, ref["w_fem"]), "w": pct(w, ref["w_kirchhoff"]),
+                       "w_vs_mindlin": pct(w, ref["w_mindlin"]),
+                       "w_vs_fem_finest": pct(w, ref["w_fem_finest"])},
             "primary": "w_vs_fem"}
+
+
+def extract_cantilever_large(series, summary, R):
+    ref = R["cantilever_large"]
+    uz, ux = series["tip_uz"][-1], series["tip_ux"][-1]
+    ex_z = 2 * series["x095_uz"][-1] - series["x090_uz"][-1]
+    ex_x = 2 * series["x095_ux"][-1] - series["x090_ux"][-1]
+    return {"values": {"tip_uz": uz, "tip_ux": ux, "tip_uz_extrapolated": ex_z,
+                       "tip_ux_extrapolated": ex_x},
+            "errors": {"tip_uz": pct_along(uz, ref["tip_uz_fem"]),
+                       "tip_ux": pct_along(ux, ref["tip_ux_fem"]),
+                       "tip_uz_vs_fem_finest": pct_along(uz, ref["tip_uz_fem_finest"]),
+                       "tip_uz_extrapolated": pct_along(ex_z, ref["tip_uz_fem"]),
+                       "tip_ux_extrapolated": pct_along(ex_x, ref["tip_ux_fem"])},
+            "primary": "tip_uz"}
+
+
+def extract_cook(case):
+    def extract(series, summary, R):
+        ref = R[case]
+        v = {"corner_uy": series["corner_uy"][-1], "corner_ux": series["corner_ux"][-1],
+             "edge_mid_uy": series["edge_mid_uy"][-1]}
+        e = {k: pct_along(v[k], ref[k + "_fem"]) for k in v}
+        e["corner_uy_vs_fem_finest"] = pct_along(v["corner_uy"], ref["corner_uy_fem_finest"])
+        return {"values": v, "errors": e, "primary": "corner_uy"}
+    extract.__name__ = "extract_" + case
+    return extract
+
+
+def extract_plate_hole(series, summary, R):
+    ref = R["plate_hole"]
+    ux = series["end_ux"][-1]
+    kt = series["hole_top_sxx"][-1] / ref["traction"]
+    return {"values": {"end_ux": ux, "kt_top": kt,
+                       "hole_top_syy": series["hole_top_syy"][-1]},
+            "errors": {"end_ux": pct_along(ux, ref["end_ux_fem"]),
+                       "kt_top": pct(kt, ref["kt_top_fem"]),
+                       "kt_top_vs_peterson": pct(kt, ref.get("kt_peterson")),
+                       "end_ux_vs_fem_finest": pct_along(ux, ref["end_ux_fem_finest"])},
+            "primary": "end_ux"}
 
 
 # --------------------------------------------------------------------------------------------
@@ -402,6 +590,7 @@ def hourglass_studies(clamped):
 # Ladder variants at other alphas: how much of each result is the penalty's choice?
 ALPHA_VARIANTS = [("alpha1", {"hourglass.alpha": "1"}), ("alpha30", {"hourglass.alpha": "30"})]
 DYNAMIC_ALPHA_LADDER = [0.025, 0.0125]  # 10 through cut (budget)
+STATIC_ALPHA_LADDER = [0.025, 0.0125, 0.01, 0.1 / 12]  # 16 through cut (budget)
 
 PROBLEMS = [
     Problem("oscillating_plate", "Oscillating plate (Gray, Monaghan & Swift 2001), 2D",
@@ -412,13 +601,14 @@ PROBLEMS = [
                               "time.cfl": CFL + [0.8]}, **hourglass_studies(False)),
             checked=["period"]),
     Problem("cantilever_static", "Cantilever under self-weight, static, 3D",
-            "cantilever_static.ini", 3, 0.1, [0.025, 0.0125, 0.01, 0.1 / 12], 0.025,
+            "cantilever_static.ini", 3, 0.1, [0.025, 0.0125, 0.01, 0.1 / 12, 0.00625], 0.025,
             0.025, extract_cantilever_static, True, "tip deflection", "m",
-            target=("tip", 1.0), variants=[("", {})] + ALPHA_VARIANTS,
+            target=("tip_vs_fem", 0.5), variants=[("", {})] + ALPHA_VARIANTS,
+            variant_ladders={v: STATIC_ALPHA_LADDER for v, _ in ALPHA_VARIANTS},
             sensitivity=dict({"kernel.support": SUPPORT, "kernel.correction": LINEAR,
                               "time.cfl": CFL, "static.tolerance": TOL},
                              **hourglass_studies(True)),
-            checked=["tip", "tip_extrapolated"], clamps=["root"]),
+            checked=["tip_vs_fem", "tip", "tip_extrapolated"], clamps=["root"]),
     Problem("cantilever_dynamic", "Cantilever, gravity applied suddenly, 3D",
             "cantilever_dynamic.ini", 3, 0.1, [0.025, 0.0125, 0.01], 0.025, 0.025,
             extract_cantilever_dynamic, False, "first bending frequency", "Hz",
@@ -426,7 +616,8 @@ PROBLEMS = [
             variant_ladders={v: DYNAMIC_ALPHA_LADDER for v, _ in ALPHA_VARIANTS},
             sensitivity=dict({"kernel.correction": LINEAR, "time.cfl": CFL},
                              **hourglass_studies(True)),
-            checked=["frequency", "mean_deflection"], clamps=["root"]),
+            checked=["frequency", "mean_deflection", "time_average_deflection_vs_fem"],
+            clamps=["root"]),
     Problem("csm1", "Turek & Hron CSM1, static, 2D", "turek_hron_csm1.ini", 2, 0.02,
             [0.005, 0.0025, 0.00125], 0.005, 0.0025, extract_csm1, True,
             "tip displacement (point A)", "m", target=("displacement", 2.0),
@@ -441,12 +632,33 @@ PROBLEMS = [
                               "time.cfl": CFL}, **hourglass_studies(True)),
             checked=["frequency", "uy_mean", "uy_amp", "ux_mean", "ux_amp"], clamps=["root"]),
     Problem("clamped_plate", "Clamped square plate under pressure, static, 3D",
-            "clamped_plate.ini", 3, 0.05, [0.0125, 0.05 / 6, 0.00625], 0.0125, 0.0125,
-            extract_clamped_plate, True, "centre deflection", "m",
+            "clamped_plate.ini", 3, 0.05, [0.0125, 0.05 / 6, 0.00625, 0.005, 0.003125], 0.0125,
+            0.0125, extract_clamped_plate, True, "centre deflection", "m",
+            target=("w_vs_fem", 0.5),
             sensitivity=dict({"kernel.support": SUPPORT, "kernel.correction": LINEAR,
                               "time.cfl": CFL, "static.tolerance": TOL},
                              **hourglass_studies(True)),
             checked=["w_vs_fem"], clamps=["left", "right", "front", "back"]),
+    # The problems with CalculiX references only (validation/fem.py): ladders, no sensitivity
+    # studies (budget). "Per thickness": through the section (cantilever), along the loaded
+    # edge (Cook, 0.016 m), across the hole's diameter (plate with a hole, 0.02 m).
+    Problem("cantilever_large", "Cantilever under a large self-weight (g = 30), static, 3D",
+            "cantilever_large.ini", 3, 0.1, [0.025, 0.0125, 0.01], 0.025, 0.025,
+            extract_cantilever_large, True, "tip displacement u_z", "m",
+            checked=["tip_uz", "tip_ux"], clamps=["root"]),
+    Problem("cook_membrane", "Cook's membrane, plane strain, nu = 0.3, static, 2D",
+            "cook_membrane.ini", 2, 0.016, [0.002, 0.001, 0.0005], 0.002, 0.002,
+            extract_cook("cook_membrane"), True, "corner displacement u_y", "m",
+            checked=["corner_uy", "corner_ux"], clamps=["left"]),
+    Problem("cook_membrane_incompressible",
+            "Cook's membrane, nearly incompressible (nu = 0.4999), static, 2D",
+            "cook_membrane_incompressible.ini", 2, 0.016, [0.002, 0.001, 0.0005], 0.002, 0.002,
+            extract_cook("cook_membrane_incompressible"), True, "corner displacement u_y", "m",
+            checked=["corner_uy", "corner_ux"], clamps=["left"]),
+    Problem("plate_hole", "Plate with a central hole in tension, plane strain, static, 2D",
+            "plate_hole.ini", 2, 0.02, [0.0025, 0.00125, 0.000625], 0.0025, 0.0025,
+            extract_plate_hole, True, "end displacement u_x", "m",
+            checked=["end_ux", "kt_top"], clamps=["left"]),
 ]
 BY_KEY = {p.key: p for p in PROBLEMS}
 DEFAULTS = {"kernel.support": 2.1, "kernel.correction": "quadratic", "hourglass.alpha": 10.0,
@@ -588,12 +800,43 @@ def machine_info(threads, build_dir):
             "tlsph_version": version, "build_dir": rel(build_dir), "build_type": build_type}
 
 
+def scene_end_time(scene):
+    """[time] end of a scene file (the first and the final frame only when it is the output
+    interval)."""
+    section = None
+    for line in Path(scene).read_text().splitlines():
+        line = line.split("#", 1)[0].split(";", 1)[0].strip()
+        if line.startswith("[") and line.endswith("]"):
+            section = line[1:-1].strip()
+        elif section == "time" and "=" in line:
+            k, v = (x.strip() for x in line.split("=", 1))
+            if k == "end":
+                return float(v)
+    raise ValueError("%s: no [time] end" % scene)
+
+
+FIELD_OUTPUT = "displacement cauchy_stress flags"
+
+
+def wants_fields(problem, run):
+    """Field comparison with the FEM: ladder runs of the static problems that have an FEM
+    VTU, in the full validation only (the quick check writes no frames)."""
+    return bool(run.get("compare_fields") and run["kind"] == "ladder" and
+                problem.key in FIELD_PROBLEMS)
+
+
 def build_command(problem, run, build_dir, runs_dir):
     scene = ROOT / "validation" / "scenes" / problem.scene
     outdir = Path(runs_dir) / run["id"]
+    if wants_fields(problem, run):
+        # the first and the final frame only (a static run writes its converged state)
+        output = ["--output.fields=" + FIELD_OUTPUT,
+                  "--output.every_time=" + fmt(scene_end_time(scene))]
+    else:
+        output = ["--output.fields=none"]
     argv = [str(Path(build_dir) / "tlsph"), "run", str(scene),
-            "--output.directory=" + str(outdir), "--output.fields=none", "--no-progress",
-            "--scene.dx=" + fmt(run["dx"])]
+            "--output.directory=" + str(outdir)] + output + [
+            "--no-progress", "--scene.dx=" + fmt(run["dx"])]
     for k, v in run["overrides"].items():
         argv.append("--%s=%s" % (k, v))
     env = ["OMP_NUM_THREADS=%d" % run["threads"]]
@@ -607,6 +850,7 @@ def build_command(problem, run, build_dir, runs_dir):
 def execute(problem, run, build_dir, runs_dir, R, git, reuse, timeout):
     argv, outdir, shown = build_command(problem, run, build_dir, runs_dir)
     rec = dict(run)
+    rec.pop("compare_fields", None)
     rec.update(command=shown, git=git["commit"],
                per_thickness=per_thickness(problem, run["dx"]))
     sidecar = outdir / "runner.json"
@@ -626,8 +870,10 @@ def execute(problem, run, build_dir, runs_dir, R, git, reuse, timeout):
             pass
     if not reused:
         outdir.mkdir(parents=True, exist_ok=True)
-        for name in ("summary.json", "probes.csv", "energies.csv"):
+        for name in ("summary.json", "probes.csv", "energies.csv", "compare.json"):
             (outdir / name).unlink(missing_ok=True)
+        for old_frame in list(outdir.glob("*.vtu")) + list(outdir.glob("*.pvd")):
+            old_frame.unlink()
         env = dict(os.environ, OMP_NUM_THREADS=str(run["threads"]))
         if run.get("wait_policy"):
             env["OMP_WAIT_POLICY"] = run["wait_policy"]
@@ -683,7 +929,51 @@ def execute(problem, run, build_dir, runs_dir, R, git, reuse, timeout):
             rec["extract_error"] = "%s: %s" % (type(e).__name__, e)
     if not problem.static and run["kind"] == "ladder" and series.get("time"):
         rec["history"] = decimate(series, HISTORY_COLUMNS.get(problem.key, []))
+    if wants_fields(problem, run):
+        rec["fields"] = compare_fields(problem, rec, build_dir, outdir)
     return rec
+
+
+def compare_fields(problem, rec, build_dir, outdir):
+    """`tlsph compare RUN FEM.vtu --json RUN/compare.json --no-output` on the run's final
+    frame: the displacement and stress error norms against the FEM solution (docs/compare.md)."""
+    case = FEM_CASE[problem.key]
+    vtu = fem_vtu(case)
+    out = {"fem_case": case, "fem_vtu": rel(vtu)}
+    if not vtu.exists():
+        out["skipped"] = "no FEM VTU %s (run /usr/bin/python3 validation/fem.py)" % rel(vtu)
+        return out
+    if rec.get("outcome") not in ("converged", "finished", "not-converged"):
+        out["skipped"] = "run did not finish (%s)" % (rec.get("outcome") or rec.get("rc"))
+        return out
+    js = outdir / "compare.json"
+    js.unlink(missing_ok=True)
+    argv = [str(Path(build_dir) / "tlsph"), "compare", str(outdir), str(vtu), "--json",
+            str(js), "--no-output"]
+    out["command"] = " ".join(shlex.quote(a) for a in
+                              [rel(argv[0]), "compare", rel(outdir), rel(vtu), "--json",
+                               rel(js), "--no-output"])
+    try:
+        proc = subprocess.run(argv, cwd=ROOT, capture_output=True, text=True, timeout=1800)
+        if proc.returncode != 0:
+            out["error"] = "exit %d: %s" % (proc.returncode, (proc.stderr or "")[-1000:].strip())
+            return out
+        data = json.loads(js.read_text())
+    except (OSError, ValueError, subprocess.SubprocessError) as e:
+        out["error"] = "%s: %s" % (type(e).__name__, e)
+        return out
+    for k in ("frame", "time", "step", "body_particles", "compared_particles",
+              "outside_particles"):
+        out[k] = data.get(k)
+    if isinstance(out.get("frame"), str):
+        out["frame"] = rel(out["frame"])
+    for name, f in (data.get("fields") or {}).items():
+        out[name] = {k: f.get(k) for k in ("unit", "compared", "l2_relative", "rms_absolute",
+                                          "max_absolute", "max_at", "max_reference",
+                                          "max_relative")}
+    out["notes"] = data.get("notes") or []
+    out["warnings"] = data.get("warnings") or []
+    return out
 
 
 # Probe columns kept (decimated) in results.json for the time-history plots.
@@ -799,6 +1089,50 @@ def check_against(tolerances, records):
 
 
 # --------------------------------------------------------------------------------------------
+# FEM references
+
+
+def regenerate_fem(plan, no_fem):
+    """The full validation regenerates the FEM references its problems need (validation/fem.py,
+    CalculiX; imported here only: it needs numpy) into validation/fem/references.json and
+    validation/fem/out/*.vtu, unless --no-fem is given or ccx is missing: then the committed
+    references and the existing VTUs are used. Returns what was done, for results.json."""
+    cases = sorted({FEM_CASE[r["problem"]] for r in plan if r["problem"] in FEM_CASE})
+    info = {"cases": cases}
+    if not cases:
+        info["note"] = "no problem with an FEM reference in this run"
+        return info
+    if no_fem:
+        info["note"] = "--no-fem: the committed references.json and the existing VTUs used"
+    else:
+        try:
+            import fem
+            fem.ccx_path()
+        except ImportError as e:
+            info["note"] = "validation/fem.py cannot run (%s): committed references used" % e
+        except Exception as e:  # fem.FemError: no ccx
+            info["note"] = "%s: committed references used" % e
+        else:
+            print("FEM references: validation/fem.py for %s (CalculiX %s)" % (
+                ", ".join(cases), fem.ccx_version()), flush=True)
+            t0 = time.monotonic()
+            try:
+                fem.run_cases(cases, out_dir=FEM_OUT, json_path=FEM_JSON)
+                info["regenerated"] = True
+                info["note"] = "regenerated by validation/fem.py before the runs"
+            except Exception as e:  # fem.FemError, OSError
+                info["note"] = ("validation/fem.py failed (%s): the references.json on disk "
+                                "used" % e)
+            info["seconds"] = round(time.monotonic() - t0, 1)
+    missing = [c for c in cases if not fem_vtu(c).exists()]
+    if missing:
+        info["missing_vtu"] = [rel(fem_vtu(c)) for c in missing]
+    print("FEM references: %s%s" % (info["note"], "; no VTU for %s (field errors skipped)"
+                                    % ", ".join(missing) if missing else ""), flush=True)
+    return info
+
+
+# --------------------------------------------------------------------------------------------
 
 
 def main(argv=None):
@@ -846,6 +1180,11 @@ def main(argv=None):
                          "newer than its scene file (for development and for resuming an "
                          "interrupted ladder: the binary and commit are not compared)")
     ap.add_argument("--timeout", type=float, default=3600.0, help="seconds per run")
+    ap.add_argument("--no-fem", action="store_true",
+                    help="full validation: do not regenerate the FEM references with "
+                         "validation/fem.py (CalculiX); use the committed "
+                         "validation/fem/references.json and the VTUs in validation/fem/out/ "
+                         "that exist")
     args = ap.parse_args(argv)
 
     args.build_dir = str(Path(args.build_dir).resolve())
@@ -882,6 +1221,7 @@ def main(argv=None):
     for r in plan:
         r["threads"] = args.threads
         r["wait_policy"] = args.omp_wait_policy
+        r["compare_fields"] = not args.quick  # field errors against the FEM VTU: full only
     if args.plan:
         for r in plan:
             print("%-45s %s" % (r["id"], build_command(BY_KEY[r["problem"]], r, args.build_dir,
@@ -900,7 +1240,11 @@ def main(argv=None):
         except (OSError, ValueError) as e:
             raise SystemExit("cannot read %s: %s" % (args.tolerances, e))
 
+    fem_info = {"references": rel(FEM_JSON), "regenerated": False}
+    if not args.quick:
+        fem_info.update(regenerate_fem(plan, args.no_fem))
     R = compute_references()
+    fem_info["used"] = R["fem"]["cases"]
     git = git_state()
     if args.binary_commit:
         git = {"commit": args.binary_commit, "binary_built_from_export": True,
@@ -912,7 +1256,7 @@ def main(argv=None):
             "started": started, "git": git,
             "machine": machine_info(args.threads, args.build_dir),
             "omp_wait_policy": args.omp_wait_policy,
-            "quick": args.quick}
+            "quick": args.quick, "fem": fem_info}
 
     if args.quick:
         out_path = runs_dir / "quick-results.json"
@@ -921,6 +1265,9 @@ def main(argv=None):
         out_path = results_path
         previous = load_results(results_path) if only else None
     kept = [r for r in (previous or {}).get("runs", []) if r["problem"] not in only]
+    for r in kept:  # a flag an earlier runner version left in its records
+        if not isinstance(r.get("fields"), dict):
+            r.pop("fields", None)
     records = []
 
     def save():
