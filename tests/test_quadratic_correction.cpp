@@ -87,18 +87,32 @@ TEST(QuadraticCorrection, LinearCorrectionIsNotExactAtTheSurface) {
   EXPECT_GT(worstGradientError<3>(GradientCorrection::Linear, 0.0, 2.1, 54), 1e-2);
 }
 
-TEST(QuadraticCorrection, TooFewNeighboursForTheFitIsASetupError) {
-  // A 2-particle-thick strip: the fit across its thickness has no second-order term to use.
+TEST(QuadraticCorrection, TooFewNeighboursForTheFitFallsBackToTheLinearCorrection) {
+  // A 2-particle-thick strip: the fit across its thickness has no second-order term to use,
+  // so every particle keeps the linear correction, which is still exact for affine fields,
+  // and says so (ReferenceConfiguration::linearFallback).
   const double dx = 0.01;
-  auto scene = sceneOf<2>(cellCentredLattice<2>(Vec<2>::Zero(), {8, 2}, dx), dx, 1.5,
-                          testMaterial("neo-hookean"));
-  scene.gradientCorrection = GradientCorrection::Quadratic;
-  try {
-    ForceEvaluator<2> eval(std::move(scene));
-    FAIL() << "expected a SetupError";
-  } catch (const SetupError& e) {
-    const std::string what = e.what();
-    EXPECT_NE(what.find("quadratic-fit"), std::string::npos) << what;
-    EXPECT_NE(what.find("correction = linear"), std::string::npos) << what;
+  const auto X = cellCentredLattice<2>(Vec<2>::Zero(), {8, 2}, dx);
+  const Kernel<2> kernel(KernelType::WendlandC2, 1.5 * dx);
+  const std::vector<double> V(X.size(), dx * dx);
+  const auto ref = buildReferenceConfiguration<2>(X, V, kernel, {}, GradientCorrection::Quadratic);
+  EXPECT_EQ(ref.linearFallback.size(), X.size());
+  Mat<2> A;
+  A << 0.03, -0.2, 0.11, 0.05;
+  double worst = 0.0;
+  for (Index i = 0; i < ref.particleCount(); ++i) {
+    Mat<2> G = Mat<2>::Zero();
+    for (Index k = ref.neighbours.offset[i]; k < ref.neighbours.offset[i + 1]; ++k) {
+      const Index j = ref.neighbours.neighbour[k];
+      G += (A * (X[j] - X[i])) * ref.correctedGradient[k].transpose();
+    }
+    worst = std::max(worst, (G - A).norm());
   }
+  EXPECT_LT(worst, 1e-12);
+  // A full lattice block needs no fallback.
+  const auto block = cellCentredLattice<2>(Vec<2>::Zero(), {6, 6}, dx);
+  const std::vector<double> Vb(block.size(), dx * dx);
+  EXPECT_TRUE(buildReferenceConfiguration<2>(block, Vb, Kernel<2>(KernelType::WendlandC2, 2.1 * dx),
+                                             {}, GradientCorrection::Quadratic)
+                  .linearFallback.empty());
 }

@@ -132,6 +132,25 @@ void printSetup(const SceneSetup<D>& setup, const Solver<D>& solver) {
   }
 }
 
+// Warnings only the solver's set-up can give (added to the scene's, for summary.json).
+template <int D>
+void addSolverWarnings(SceneSetup<D>& setup, const Solver<D>& solver, const std::string& command) {
+  const auto& fallback = solver.reference().linearFallback;
+  if (fallback.empty()) return;
+  const Index i = fallback.front();
+  std::ostringstream w;
+  w << setup.sourceFile << ": [kernel] correction: " << fallback.size() << " of "
+    << setup.scene.particles.size() << " particles (e.g. particle " << i << " at ("
+    << setup.scene.particles.referencePosition[i].transpose() << ") with "
+    << solver.reference().neighbours.count(i)
+    << " neighbours) have too few neighbours on two levels for the quadratic correction's fit "
+       "(an acute corner, a strip two particles thick); they use the linear correction (6.69), "
+       "exact for affine fields only. Raise [kernel] support (2.3 serves Cook's membrane) to "
+       "use the quadratic one everywhere";
+  setup.warnings.push_back(w.str());
+  std::cerr << command << ": warning: " << w.str() << "\n";
+}
+
 template <int D>
 int runOrCheck(const Config& config, bool run, bool progress, const std::string& command) {
   SceneSetup<D> setup = buildScene<D>(config);
@@ -140,6 +159,7 @@ int runOrCheck(const Config& config, bool run, bool progress, const std::string&
   if (!run) {
     Scene<D> copy = setup.scene;  // the check builds the solver's set-up without running
     Solver<D> solver(copy, setup.solver);
+    addSolverWarnings(setup, solver, command);
     printSetup(setup, solver);
     return 0;
   }
@@ -148,6 +168,7 @@ int runOrCheck(const Config& config, bool run, bool progress, const std::string&
   options.command = command;
   NeighbourStats neighbours;
   const RunSummary s = runSimulation(setup, options, [&](const Solver<D>& solver) {
+    addSolverWarnings(setup, solver, command);
     printSetup(setup, solver);
     neighbours = neighbourStats(solver, setup.scene.particles.size());
   });

@@ -123,7 +123,14 @@ ReferenceConfiguration<D> buildReferenceConfiguration(
       const double largest = eigen.eigenvalues().maxCoeff();
       fitCondition[i] =
           largest > 0.0 ? std::max(0.0, eigen.eigenvalues().minCoeff()) / largest : 0.0;
-      if (fitCondition[i] > 0.0) {
+      // Too few neighbours on two levels for the fit (an acute corner, a strip two particles
+      // thick): this particle keeps the linear correction (listed in linearFallback).
+      if (fitCondition[i] < minCorrectionCondition * minCorrectionCondition) {
+        for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
+          ref.correctedGradient[k] = ref.linearGradient[k];
+          G += ref.correctedGradient[k];
+        }
+      } else {
         const Moment Minv =
             Moment(eigen.eigenvectors() * eigen.eigenvalues().cwiseInverse().asDiagonal() *
                    eigen.eigenvectors().transpose());
@@ -148,14 +155,8 @@ ReferenceConfiguration<D> buildReferenceConfiguration(
     }
     // The fit's moment matrix is a Gram matrix of monomials: its eigenvalue ratio is the
     // square of a condition number, so the bar is squared too.
-    const double fitNeeded = minCorrectionCondition * minCorrectionCondition;
-    if (fitCondition[i] < fitNeeded) {
-      position << X[i].transpose();
-      throw SetupError(conditionMessage(i, position.str(), nb.count(i),
-                                        "quadratic-fit moment matrix", fitCondition[i], fitNeeded,
-                                        D) +
-                       " (or use [kernel] correction = linear)");
-    }
+    if (fitCondition[i] < minCorrectionCondition * minCorrectionCondition)
+      ref.linearFallback.push_back(i);
   }
 
   ref.reverseGradient = reverseVectors<D>(nb, ref.correctedGradient, volume);

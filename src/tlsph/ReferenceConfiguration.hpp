@@ -43,6 +43,9 @@ struct ReferenceConfiguration {
   std::vector<Vec<D>> gradientSum;           // s_I = sum_J w_IJ
   std::vector<Vec<D>> correctedGradientSum;  // G_I = sum_J g_IJ
   GradientCorrection correction = GradientCorrection::Linear;
+  // Quadratic correction only: particles whose neighbourhood cannot carry the quadratic fit
+  // (an acute corner, a strip two particles thick) and use the linear g_IJ instead.
+  std::vector<Index> linearFallback;
 
   Index particleCount() const { return neighbours.particleCount(); }
 };
