@@ -34,13 +34,19 @@ std::vector<double> hourglassError(const ReferenceConfiguration<D>& ref,
   return out;
 }
 
-// The full 3D Cauchy stress sigma = P F^T / J of particle i (in plane strain with sigma_33).
+// The full 3D first Piola-Kirchhoff stress of particle i for its F (in plane strain F_33 = 1,
+// so P_33 and sigma_33 are not zero), and the Cauchy stress sigma = P F^T / J.
+template <int D>
+Mat3 firstPiolaOf(const SceneSetup<D>& setup, const Mat<D>& F, Index i) {
+  const Mat3 F3 = embedDeformationGradient<D>(F);
+  return std::visit([&](const auto& model) { return model.firstPiolaKirchhoff(F3); },
+                    setup.scene.materials[setup.scene.particles.material[i]]);
+}
+
 template <int D>
 Mat3 cauchyStressOf(const SceneSetup<D>& setup, const Mat<D>& F, Index i) {
   const Mat3 F3 = embedDeformationGradient<D>(F);
-  const Mat3 P = std::visit([&](const auto& model) { return model.firstPiolaKirchhoff(F3); },
-                            setup.scene.materials[setup.scene.particles.material[i]]);
-  return P * F3.transpose() / F3.determinant();
+  return firstPiolaOf(setup, F, i) * F3.transpose() / F3.determinant();
 }
 
 // Every field name makeFrame knows, in the order of docs/scene-format.md ([output] fields).
@@ -74,14 +80,6 @@ Frame makeFrame(const SceneSetup<D>& setup, const Solver<D>& solver,
     frame.fields.push_back(std::move(f));
   };
   const auto& F = solver.forces().deformationGradient();
-  // The full 3D P and Cauchy stress: in plane strain sigma_33 is not zero.
-  auto piola3 = [&](Index i) {
-    return std::visit(
-        [&](const auto& model) {
-          return model.firstPiolaKirchhoff(embedDeformationGradient<D>(F[i]));
-        },
-        setup.scene.materials[p.material[i]]);
-  };
   for (const auto& name : fields) {
     if (name == "displacement") {
       vectorField(name, p.displacement);
@@ -96,10 +94,8 @@ Frame makeFrame(const SceneSetup<D>& setup, const Solver<D>& solver,
       PointField f{name, name == "von_mises" ? 1 : 9, {}};
       f.values.resize(f.components * n);
       for (Index i = 0; i < n; ++i) {
-        const Mat3 F3 = embedDeformationGradient<D>(F[i]);
-        const Mat3 P = piola3(i);
-        Mat3 out = P;
-        if (name != "first_piola") out = P * F3.transpose() / F3.determinant();  // sigma
+        const Mat3 out =
+            name == "first_piola" ? firstPiolaOf(setup, F[i], i) : cauchyStressOf(setup, F[i], i);
         if (name == "von_mises") {
           const Mat3 dev = out - out.trace() / 3.0 * Mat3::Identity();
           f.values[i] = std::sqrt(1.5 * dev.squaredNorm());

@@ -83,7 +83,7 @@ class Solver {
     for (const auto& m : scene.mirrorGhosts)
       if (m.motion >= 0 && scene.prescriptions[m.motion].motion != PrescribedMotion::Fixed)
         movingMirrors_ = true;
-    mirrorDrive(0.0, drive_, &driveRate_);
+    updateMirrorDrive(0.0);
     mirrorGhostMotion();
     forces_.compute(scene.particles.displacement, scene.particles.force, &scene.particles.velocity);
     chainMirrorForces();
@@ -140,7 +140,7 @@ class Solver {
     std::vector<Vec<D>> driveStep;
     if (movingMirrors_) {
       driveStep = drive_;
-      mirrorDrive(time_, drive_, &driveRate_);
+      updateMirrorDrive(time_);
       for (std::size_t k = 0; k < drive_.size(); ++k) {
         driveStep[k] = drive_[k] - driveStep[k];
         boundaryWork -= 0.5 * p.force[scene_.mirrorGhosts[k].ghost].dot(driveStep[k]);
@@ -286,27 +286,26 @@ class Solver {
     return ghosts;
   }
 
-  // The prescribed part of each mirrored ghost's displacement at time t,
-  //   d_g = u_p(X_g) - w1 u_p(X_1) - w2 u_p(X_2)   (MirrorGhost), and its rate;
-  // empty when every mirrored face is held fixed (then d_g = 0).
-  void mirrorDrive(double t, std::vector<Vec<D>>& drive, std::vector<Vec<D>>* rate) const {
+  // The prescribed part of each mirrored ghost's displacement at time t and its rate,
+  //   d_g = u_p(X_g) - w1 u_p(X_1) - w2 u_p(X_2)   (MirrorGhost),
+  // into drive_ and driveRate_; kept only when some mirrored face moves (else d_g = 0).
+  void updateMirrorDrive(double t) {
     if (!movingMirrors_) return;
     const auto& X = scene_.particles.referencePosition;
     const auto n = scene_.mirrorGhosts.size();
-    drive.assign(n, Vec<D>::Zero());
-    if (rate) rate->assign(n, Vec<D>::Zero());
+    drive_.assign(n, Vec<D>::Zero());
+    driveRate_.assign(n, Vec<D>::Zero());
     for (std::size_t k = 0; k < n; ++k) {
       const auto& m = scene_.mirrorGhosts[k];
       if (m.motion < 0) continue;
       const auto& rule = scene_.prescriptions[m.motion];
-      drive[k] = prescribedDisplacementAt(rule, X[m.ghost], t) -
-                 m.w1 * prescribedDisplacementAt(rule, X[m.mirror], t);
-      if (m.second >= 0) drive[k] -= m.w2 * prescribedDisplacementAt(rule, X[m.second], t);
-      if (rate) {
-        (*rate)[k] = prescribedVelocityAt(rule, X[m.ghost], t) -
-                     m.w1 * prescribedVelocityAt(rule, X[m.mirror], t);
-        if (m.second >= 0) (*rate)[k] -= m.w2 * prescribedVelocityAt(rule, X[m.second], t);
-      }
+      auto part = [&](Vec<D> (*at)(const Prescription<D>&, const Vec<D>&, double)) {
+        Vec<D> d = at(rule, X[m.ghost], t) - m.w1 * at(rule, X[m.mirror], t);
+        if (m.second >= 0) d -= m.w2 * at(rule, X[m.second], t);
+        return d;
+      };
+      drive_[k] = part(prescribedDisplacementAt<D>);
+      driveRate_[k] = part(prescribedVelocityAt<D>);
     }
   }
 
