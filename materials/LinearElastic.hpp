@@ -4,6 +4,7 @@
 #include <Eigen/Core>
 
 #include "materials/ModelParameters.hpp"
+#include "materials/Tensor.hpp"
 
 namespace tlsph {
 
@@ -32,6 +33,19 @@ class LinearElastic : public ModelParameters {
     Eigen::Matrix3d sigma = 2.0 * constants().mu * eps;
     sigma.diagonal().array() += constants().lambda * eps.trace();
     return sigma;
+  }
+
+  // A = dP/dF (A(i+3j, k+3l) = dP_ij/dF_kl, see Material.hpp). P is linear in F:
+  // dP = lambda tr(dF) 1 + mu (dF + dF^T), so A = lambda vec(1) vec(1)^T + mu (Id + T) with
+  // T the transpose map, for every F.
+  Eigen::Matrix<double, 9, 9> tangentModulus(const Eigen::Matrix3d& /*F*/) const {
+    const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+    const tensor::Vector9d one = tensor::vec(I);
+    const double mu = constants().mu;
+    tensor::Tangent A = constants().lambda * one * one.transpose();
+    tensor::addLeftRight(A, mu, I, I);            // mu dF
+    tensor::addLeftTransposedRight(A, mu, I, I);  // mu dF^T
+    return A;
   }
 
  private:

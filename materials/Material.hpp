@@ -20,10 +20,17 @@
 namespace tlsph {
 
 // What the solver needs from a model; every alternative of Material satisfies it.
+//
+// tangentModulus(F) is A = dP/dF = d2 psi / dF dF as a 9x9 matrix: F(i, j) and P(i, j) are
+// flattened in Eigen's column-major storage order, (i, j) -> i + 3 j, and
+// A(a, b) = dP_a / dF_b, so vec(dP) = A vec(dF) with vec(M) = Map<Matrix<double, 9, 1>>(M.data()).
+// A is major-symmetric (A = A^T, hyperelastic). Where the model is undefined (det F <= 0) it
+// is quiet NaN, like the stress.
 template <class M>
 concept MaterialModel = requires(const M& m, const Eigen::Matrix3d& F) {
   { m.strainEnergyDensity(F) } -> std::same_as<double>;
   { m.firstPiolaKirchhoff(F) } -> std::same_as<Eigen::Matrix3d>;
+  { m.tangentModulus(F) } -> std::same_as<Eigen::Matrix<double, 9, 9>>;
   { m.constants() } -> std::same_as<const ElasticConstants&>;
   { m.density() } -> std::same_as<double>;
   { m.waveSpeed() } -> std::same_as<double>;
@@ -107,6 +114,26 @@ Eigen::Matrix<double, D, D> firstPiolaKirchhoff(const Model& model,
     return model.firstPiolaKirchhoff(embedDeformationGradient<2>(F)).template topLeftCorner<2, 2>();
 }
 
+// A = dP/dF with the convention of MaterialModel, in D dimensions: index i + D j. In plane
+// strain (D = 2) this is the in-plane block of the 3D tangent at the embedded F: rows and
+// columns at the 3D indices i + 3 j with i, j < 2, i.e. {0, 1, 3, 4}, mapped to i + 2 j.
+template <int D, MaterialModel Model>
+Eigen::Matrix<double, D * D, D * D> tangentModulus(const Model& model,
+                                                   const Eigen::Matrix<double, D, D>& F) {
+  static_assert(D == 2 || D == 3, "TLSPH runs in 2D (plane strain) or 3D");
+  if constexpr (D == 3) {
+    return model.tangentModulus(F);
+  } else {
+    const Eigen::Matrix<double, 9, 9> A3 = model.tangentModulus(embedDeformationGradient<2>(F));
+    constexpr int inPlane[4] = {0, 1, 3, 4};
+    Eigen::Matrix4d A;
+    for (int b = 0; b < 4; ++b)
+      for (int a = 0; a < 4; ++a)
+        A(a, b) = A3(inPlane[a], inPlane[b]);
+    return A;
+  }
+}
+
 template <int D, MaterialModel Model>
 double strainEnergyDensity(const Model& model, const Eigen::Matrix<double, D, D>& F) {
   static_assert(D == 2 || D == 3, "TLSPH runs in 2D (plane strain) or 3D");
@@ -127,6 +154,12 @@ Eigen::Matrix<double, D, D> firstPiolaKirchhoff(const Material& material,
 template <int D>
 double strainEnergyDensity(const Material& material, const Eigen::Matrix<double, D, D>& F) {
   return std::visit([&](const auto& m) { return strainEnergyDensity<D>(m, F); }, material);
+}
+
+template <int D>
+Eigen::Matrix<double, D * D, D * D> tangentModulus(const Material& material,
+                                                   const Eigen::Matrix<double, D, D>& F) {
+  return std::visit([&](const auto& m) { return tangentModulus<D>(m, F); }, material);
 }
 
 static_assert(MaterialModel<LinearElastic> && MaterialModel<SaintVenantKirchhoff> &&

@@ -71,6 +71,47 @@ class MooneyRivlin : public ModelParameters {
     return P;
   }
 
+  // A = dP/dF (A(i+3j, k+3l) = dP_ij/dF_kl, see Material.hpp). With H = F^{-T},
+  // N = I1 F - F C (dI2 = 2 N:dF) and the coefficients of firstPiolaKirchhoff,
+  //   P = (a + b I1) F - b F C + h H,   h = J g = -a I1/3 - 2 b I2/3 + K J (J - 1),
+  // and da = -2/3 a (H:dF), db = -4/3 b (H:dF), dI1 = 2 F:dF, dJ = J H:dF, dH = -H dF^T H,
+  // d(F C) = dF C + F dF^T F + F F^T dF, term by term:
+  //   dP = (a + b I1) dF - b (dF C + F dF^T F + F F^T dF) - h H dF^T H
+  //      + 2 b (F:dF) F - 2/3 a [(H:dF) F + (F:dF) H] - 4/3 b [(H:dF) N + (N:dF) H]
+  //      + (2/9 a I1 + 8/9 b I2 + K J (2 J - 1)) (H:dF) H.
+  Eigen::Matrix<double, 9, 9> tangentModulus(const Eigen::Matrix3d& F) const {
+    const Eigen::Matrix3d cof = tensor::cofactor(F);
+    const double J = tensor::determinantFromCofactor(F, cof);
+    if (!(J > 0.0)) return tensor::undefinedTangent();
+    const Eigen::Matrix3d C = F.transpose() * F;
+    const double I1 = C.trace();
+    const double I2 = 0.5 * (I1 * I1 - C.squaredNorm());
+    const double cbrtJ = std::cbrt(J);
+    const double Jm23 = 1.0 / (cbrtJ * cbrtJ);
+    const double a = 2.0 * c10_ * Jm23;
+    const double b = 2.0 * c01_ * Jm23 * Jm23;
+    const double K = constants().bulkModulus;
+    const double h = -a * I1 / 3.0 - 2.0 * b * I2 / 3.0 + K * J * (J - 1.0);
+    const Eigen::Matrix3d H = cof / J;
+    const Eigen::Matrix3d FC = F * C;
+    const tensor::Vector9d f = tensor::vec(F);
+    const tensor::Vector9d hv = tensor::vec(H);
+    const tensor::Vector9d n = tensor::vec(I1 * F - FC);
+    const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+
+    tensor::Tangent A = (2.0 * b) * f * f.transpose();
+    A.noalias() -= (2.0 / 3.0 * a) * (f * hv.transpose() + hv * f.transpose());
+    A.noalias() -= (4.0 / 3.0 * b) * (n * hv.transpose() + hv * n.transpose());
+    A.noalias() +=
+        (2.0 / 9.0 * a * I1 + 8.0 / 9.0 * b * I2 + K * J * (2.0 * J - 1.0)) * hv * hv.transpose();
+    A.diagonal().array() += a + b * I1;
+    tensor::addLeftRight(A, -b, I, C);
+    tensor::addLeftRight(A, -b, F * F.transpose(), I);
+    tensor::addLeftTransposedRight(A, -b, F, F);
+    tensor::addLeftTransposedRight(A, -h, H, H);
+    return A;
+  }
+
  private:
   double c10_;
   double c01_;

@@ -4,6 +4,7 @@
 #include <Eigen/Core>
 
 #include "materials/ModelParameters.hpp"
+#include "materials/Tensor.hpp"
 
 namespace tlsph {
 
@@ -30,6 +31,24 @@ class SaintVenantKirchhoff : public ModelParameters {
     Eigen::Matrix3d S = 2.0 * constants().mu * E;
     S.diagonal().array() += constants().lambda * E.trace();
     return F * S;
+  }
+
+  // A = dP/dF (A(i+3j, k+3l) = dP_ij/dF_kl, see Material.hpp). dP = dF S + F dS with
+  // dS = lambda tr(dE) 1 + 2 mu dE, dE = sym(F^T dF), tr(dE) = F:dF:
+  //   dP = dF S + lambda (F:dF) F + mu (F F^T dF + F dF^T F).
+  Eigen::Matrix<double, 9, 9> tangentModulus(const Eigen::Matrix3d& F) const {
+    const double lambda = constants().lambda;
+    const double mu = constants().mu;
+    const Eigen::Matrix3d E = greenLagrange(F);
+    Eigen::Matrix3d S = 2.0 * mu * E;
+    S.diagonal().array() += lambda * E.trace();
+    const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+    const tensor::Vector9d f = tensor::vec(F);
+    tensor::Tangent A = lambda * f * f.transpose();
+    tensor::addLeftRight(A, 1.0, I, S);
+    tensor::addLeftRight(A, mu, F * F.transpose(), I);
+    tensor::addLeftTransposedRight(A, mu, F, F);
+    return A;
   }
 
  private:

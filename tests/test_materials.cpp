@@ -86,6 +86,69 @@ MatD<D> finiteDifferenceStress(const Model& model, const MatD<D>& F) {
   return P;
 }
 
+// ---- Tangent modulus helpers ---------------------------------------------------------------
+
+template <int D>
+using TangentD = Eigen::Matrix<double, D * D, D * D>;
+template <int D>
+using VecD = Eigen::Matrix<double, D * D, 1>;
+
+// M flattened in storage order, M(i, j) -> i + D j (the tangent modulus convention).
+template <int D>
+VecD<D> flatten(const MatD<D>& M) {
+  return Eigen::Map<const VecD<D>>(M.data());
+}
+template <int D>
+MatD<D> unflatten(const VecD<D>& v) {
+  return Eigen::Map<const MatD<D>>(v.data());
+}
+
+// Frobenius norm of a tangent, by a plain loop: with -march=native, Eigen's fully unrolled
+// AVX-512 reduction of a fixed 4 x 4 matrix trips a false GCC 12 -Wuninitialized inside the
+// compiler's own intrinsics header.
+template <class Derived>
+double tangentNorm(const Eigen::MatrixBase<Derived>& A) {
+  double sum = 0.0;
+  for (Eigen::Index j = 0; j < A.cols(); ++j)
+    for (Eigen::Index i = 0; i < A.rows(); ++i)
+      sum += A(i, j) * A(i, j);
+  return std::sqrt(sum);
+}
+
+// Central differences of P: column b is dP/dF_b. The step is 1e-6 relative to the largest
+// |F_ij|; truncation O(h^2 |d3P/dF3|) ~ 1e-12 |A| and round-off ~ eps_machine |P| / h ~ 1e-10 |A|,
+// far below the O(mu / |A|) ~ 1e-1 error that a wrong or missing term causes.
+constexpr double kTangentStep = 1e-6;
+constexpr double kTangentTolerance = 1e-6;  // on |A - A_fd| / |A|
+
+template <int D, class Model>
+TangentD<D> finiteDifferenceTangent(const Model& model, const MatD<D>& F) {
+  const double h = kTangentStep * F.cwiseAbs().maxCoeff();
+  TangentD<D> A;
+  for (int b = 0; b < D * D; ++b) {
+    MatD<D> Fp = F, Fm = F;
+    Fp.data()[b] += h;
+    Fm.data()[b] -= h;
+    const MatD<D> dP = firstPiolaKirchhoff<D>(model, Fp) - firstPiolaKirchhoff<D>(model, Fm);
+    A.col(b) = flatten<D>(dP) / (2 * h);
+  }
+  return A;
+}
+
+// max over `samples` random F = 1 + scale * random (det F > 0.3) of |A - A_fd| / |A|.
+template <int D, class Model>
+double maxTangentDiscrepancy(const Model& model, std::mt19937& rng, double scale, int samples) {
+  double worst = 0.0;
+  for (int sample = 0; sample < samples; ++sample) {
+    const MatD<D> F = randomDeformation<D>(rng, scale, 0.3);
+    const TangentD<D> A = tangentModulus<D>(model, F);
+    const double error = tangentNorm(A - finiteDifferenceTangent<D>(model, F)) / tangentNorm(A);
+    EXPECT_LT(error, kTangentTolerance) << "F =\n" << F;
+    worst = std::max(worst, error);
+  }
+  return worst;
+}
+
 // ---- Typed over (model, dimension) ---------------------------------------------------------
 
 template <class M, int Dim>
@@ -148,6 +211,49 @@ TYPED_TEST(MaterialModelTest, StressIsEnergyGradientAtLargeDeformation) {
     const auto P = firstPiolaKirchhoff<D>(this->model, F);
     const auto Pfd = finiteDifferenceStress<D>(this->model, F);
     EXPECT_LT((P - Pfd).norm() / P.norm(), 1e-6) << "F =\n" << F;
+  }
+}
+
+TYPED_TEST(MaterialModelTest, TangentMatchesFiniteDifferencesNearIdentity) {
+  constexpr int D = TestFixture::D;
+  const double worst = maxTangentDiscrepancy<D>(this->model, this->rng, 0.05, 10);
+  this->RecordProperty("max_relative_fd_discrepancy", ::testing::PrintToString(worst));
+}
+
+TYPED_TEST(MaterialModelTest, TangentMatchesFiniteDifferencesAtLargeDeformation) {
+  constexpr int D = TestFixture::D;
+  const double worst = maxTangentDiscrepancy<D>(this->model, this->rng, 0.3, 10);
+  this->RecordProperty("max_relative_fd_discrepancy", ::testing::PrintToString(worst));
+}
+
+// A = d2 psi / dF dF is symmetric up to rounding (the FD check alone would allow 1e-6).
+TYPED_TEST(MaterialModelTest, TangentHasMajorSymmetry) {
+  constexpr int D = TestFixture::D;
+  for (const double scale : {0.05, 0.3}) {
+    for (int sample = 0; sample < 5; ++sample) {
+      const auto F = randomDeformation<D>(this->rng, scale, 0.3);
+      const TangentD<D> A = tangentModulus<D>(this->model, F);
+      EXPECT_LE(tangentNorm(A - A.transpose()), 1e-14 * tangentNorm(A)) << "F =\n" << F;
+    }
+  }
+}
+
+// At F = 1 every model linearises to sigma(eps) = lambda tr(eps) 1 + 2 mu eps, and (stress-
+// free reference) an infinitesimal rotation W = skew(G) gives no stress.
+TYPED_TEST(MaterialModelTest, TangentAtIdentityIsLinearElasticity) {
+  constexpr int D = TestFixture::D;
+  using Mat = typename TestFixture::Mat;
+  const TangentD<D> A = tangentModulus<D>(this->model, Mat(Mat::Identity()));
+  for (int sample = 0; sample < 5; ++sample) {
+    const Mat G = randomMatrix<D>(this->rng, 1e-3);
+    const Mat eps = 0.5 * (G + G.transpose());
+    const Mat W = 0.5 * (G - G.transpose());
+    const Mat sigma = linearStress<D>(this->model.constants(), eps);
+    const Mat dP = unflatten<D>(A * flatten<D>(eps));
+    EXPECT_LE((dP - sigma).norm(), 1e-12 * sigma.norm()) << "dP =\n"
+                                                         << dP << "\nsigma =\n"
+                                                         << sigma;
+    EXPECT_LE(unflatten<D>(A * flatten<D>(W)).norm(), 1e-12 * tangentNorm(A) * W.norm());
   }
 }
 
@@ -240,6 +346,7 @@ TYPED_TEST(MaterialModelTest, VariantEntryPointsAgreeWithTheModel) {
   const Mat F = randomDeformation<D>(this->rng, 0.3);
   EXPECT_EQ(firstPiolaKirchhoff<D>(material, F), firstPiolaKirchhoff<D>(this->model, F));
   EXPECT_EQ(strainEnergyDensity<D>(material, F), strainEnergyDensity<D>(this->model, F));
+  EXPECT_EQ(tangentModulus<D>(material, F), tangentModulus<D>(this->model, F));
 }
 
 // ---- Models undefined for det F <= 0 -------------------------------------------------------
@@ -264,6 +371,7 @@ TYPED_TEST(InvertedDeformationTest, ReturnsNaNForNonPositiveJacobian) {
     const Mat P = firstPiolaKirchhoff<D>(this->model, F);
     EXPECT_TRUE(P.array().isNaN().all()) << "F =\n" << F << "\nP =\n" << P;
     EXPECT_TRUE(std::isnan(strainEnergyDensity<D>(this->model, F))) << "F =\n" << F;
+    EXPECT_TRUE(tangentModulus<D>(this->model, F).array().isNaN().all()) << "F =\n" << F;
   }
 }
 
@@ -285,6 +393,19 @@ TEST(PlaneStrain, InPlaneStressIsTheBlockOfThe3DStress) {
   const Eigen::Matrix3d P3 = model.firstPiolaKirchhoff(embedDeformationGradient<2>(F));
   EXPECT_EQ(firstPiolaKirchhoff<2>(model, F), (P3.topLeftCorner<2, 2>()));
   EXPECT_GT(std::abs(P3(2, 2)), 0.0);  // plane strain: out-of-plane stress is not zero
+}
+
+TEST(PlaneStrain, InPlaneTangentIsTheBlockOfThe3DTangent) {
+  const MooneyRivlin model(testConstants(), kDensity);
+  Eigen::Matrix2d F;
+  F << 1.1, 0.2, -0.3, 0.9;
+  const Eigen::Matrix<double, 9, 9> A3 = model.tangentModulus(embedDeformationGradient<2>(F));
+  const Eigen::Matrix4d A2 = tangentModulus<2>(model, F);
+  // 2D index i + 2 j <-> 3D index i + 3 j: F(0,0), F(1,0), F(0,1), F(1,1).
+  const int inPlane[4] = {0, 1, 3, 4};
+  for (int a = 0; a < 4; ++a)
+    for (int b = 0; b < 4; ++b)
+      EXPECT_EQ(A2(a, b), A3(inPlane[a], inPlane[b])) << "a = " << a << ", b = " << b;
 }
 
 // ---- Elastic constants ---------------------------------------------------------------------
@@ -405,6 +526,21 @@ TEST(MooneyRivlin, EveryFractionHasTheSameSmallStrainLimitAndConsistentStress) {
     const Eigen::Matrix3d F = randomDeformation<3>(rng, 0.3);
     const Eigen::Matrix3d PF = model.firstPiolaKirchhoff(F);
     EXPECT_LT((PF - finiteDifferenceStress<3>(model, F)).norm() / PF.norm(), 1e-6);
+  }
+}
+
+// The c10 and c01 terms separately: at the default fraction 0.5, c10 = c01, and a term with
+// the two coefficients swapped would go almost unnoticed near J = 1.
+TEST(MooneyRivlin, TangentMatchesFiniteDifferencesForEveryFraction) {
+  const ElasticConstants c = testConstants();
+  std::mt19937 rng(11);
+  for (const double fraction : {0.0, 0.25, 1.0}) {
+    SCOPED_TRACE("c01Fraction = " + std::to_string(fraction));
+    const MooneyRivlin model(c, kDensity, fraction);
+    maxTangentDiscrepancy<3>(model, rng, 0.3, 5);
+    maxTangentDiscrepancy<2>(model, rng, 0.3, 5);
+    const Eigen::Matrix<double, 9, 9> A = model.tangentModulus(randomDeformation<3>(rng, 0.3));
+    EXPECT_LE((A - A.transpose()).norm(), 1e-14 * A.norm());
   }
 }
 
