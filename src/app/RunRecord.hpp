@@ -129,6 +129,23 @@ void writeRunRecord(const std::filesystem::path& file, const SceneSetup<D>& setu
       << ", \"failed_frame\": " << jsonText(u.failedFrame.string()) << "}";
     field("instability", o.str());
   }
+  field(
+      "static_solver",
+      jsonText(setup.run.quasiStatic ? (setup.run.newtonStatic() ? "newton" : "damped") : "none"));
+  if (s.newton) {
+    // What the Newton static solve did and where its time went.
+    const NewtonStatistics& n = *s.newton;
+    std::ostringstream o;
+    o << "{\"load_steps\": " << n.loadSteps << ", \"iterations\": " << n.iterations
+      << ", \"krylov_iterations\": " << n.krylovIterations
+      << ", \"factorisations\": " << n.factorisations << ", \"matrix_nonzeros\": " << n.nonZeros
+      << ", \"factor_nonzeros\": " << n.factorNonZeros
+      << ", \"assembly_seconds\": " << jsonNumber(n.assemblySeconds)
+      << ", \"factorisation_seconds\": " << jsonNumber(n.factorisationSeconds)
+      << ", \"solve_seconds\": " << jsonNumber(n.solveSeconds)
+      << ", \"linear_solver\": " << jsonText(n.linearSolver) << "}";
+    field("newton", o.str());
+  }
   field("probes", jsonText(s.probes.string()));
   field("reactions_series", jsonText(s.reactions.string()));
   {

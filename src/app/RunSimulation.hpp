@@ -43,6 +43,7 @@ struct RunSummary {
   std::vector<std::pair<std::string, Vec3>> finalReactions;
   std::string message;
   std::optional<Instability> instability;  // set when the outcome is Unstable
+  std::optional<NewtonStatistics> newton;  // set for a Newton static run
 };
 
 template <int D>
@@ -166,6 +167,52 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
   recordSeries();
   writeFrame();
   RunGuard<D> guard(setup, solver);  // the stability guards (Guards.hpp)
+  // What every run reports at its end (steps, residual and energy books: the caller).
+  auto finish = [&] {
+    summary.wallSeconds = std::chrono::duration<double>(Clock::now() - start).count();
+    if (vtu) summary.pvd = vtu->pvdPath();
+    summary.energies = dir / "energies.csv";
+    if (probes) summary.probes = dir / "probes.csv";
+    if (reactions) summary.reactions = dir / "reactions.csv";
+    for (std::size_t r = 0; r < rules.size(); ++r) {
+      Vec3 R = Vec3::Zero();
+      R.head<D>() = solver.reaction(r);
+      summary.finalReactions.emplace_back(rules[r].name, R);
+    }
+    return summary;
+  };
+  if (run.newtonStatic()) {
+    // Load steps to equilibrium: one series row and one frame per converged step.
+    NewtonSolver<D> newton(setup.scene, solver, run.newton);
+    try {
+      newton.run([&] {
+        recordSeries();
+        writeFrame();
+        if (options.progress) {
+          const auto& st = newton.statistics();
+          std::fprintf(stderr,
+                       "\r\033[Kload step %d  t = %.4g s of %.4g  Newton iterations %d  "
+                       "residual %.3g (target %.3g)",
+                       st.loadSteps, solver.time(), solver.rampEnd(), st.iterations,
+                       solver.residualRatio(), run.tolerance);
+          std::fflush(stderr);
+        }
+      });
+      summary.outcome = RunOutcome::Converged;
+    } catch (const NewtonFailure& failure) {
+      summary.outcome = RunOutcome::NotConverged;
+      summary.message = failure.what();
+      recordSeries();
+      writeFrame();
+    }
+    if (options.progress) std::fprintf(stderr, "\r\033[K");
+    summary.newton = newton.statistics();
+    summary.steps = solver.stepCount();
+    summary.time = solver.time();
+    summary.residual = solver.residualRatio();
+    summary.energy = solver.energyBalance();
+    return finish();
+  }
   double nextFrameTime = out.everyTime;
   auto lastProgress = Clock::now();
   const double endTime = run.endTime * (1.0 - 1e-12);
@@ -233,17 +280,7 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
     summary.energy = solver.energyBalance();  // the failing state's books
     guard.writeFrames(*summary.instability);  // leaves the solver in the last good state
   }
-  summary.wallSeconds = std::chrono::duration<double>(Clock::now() - start).count();
-  if (vtu) summary.pvd = vtu->pvdPath();
-  summary.energies = dir / "energies.csv";
-  if (probes) summary.probes = dir / "probes.csv";
-  if (reactions) summary.reactions = dir / "reactions.csv";
-  for (std::size_t r = 0; r < rules.size(); ++r) {
-    Vec3 R = Vec3::Zero();
-    R.head<D>() = solver.reaction(r);
-    summary.finalReactions.emplace_back(rules[r].name, R);
-  }
-  return summary;
+  return finish();
 }
 
 }  // namespace tlsph

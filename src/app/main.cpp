@@ -96,6 +96,12 @@ void printSetup(const SceneSetup<D>& setup, const Solver<D>& solver) {
               << (probe.method == ProbeMethod::Nearest ? "nearest particle"
                                                        : "kernel-interpolated, first order")
               << "\n";
+  if (setup.run.newtonStatic()) {
+    const double end = solver.rampEnd();
+    std::cout << "static       Newton-Raphson, " << setup.run.newton.loadSteps
+              << " load step(s) to the end of the ramps (t = " << end
+              << " s), stop when residual < " << setup.run.tolerance << "\n";
+  }
   const double steps = setup.run.endTime / solver.timeStep();
   std::cout << "time         dt = " << solver.timeStep() << " s (CFL " << setup.solver.cfl
             << "), end " << setup.run.endTime << " s, " << (setup.run.quasiStatic ? "at most " : "")
@@ -179,10 +185,23 @@ int runOrCheck(const Config& config, bool run, bool progress, const std::string&
   const std::filesystem::path record =
       std::filesystem::path(setup.output.directory) / "summary.json";
   writeRunRecord(record, setup, neighbours, s, threads, command, kVersion);
-  std::cout << "\nsteps " << s.steps << ", simulated " << s.time << " s, wall " << s.wallSeconds
-            << " s (" << double(setup.scene.particles.size()) * s.steps / s.wallSeconds
-            << " particle-steps/s, " << threads << (threads == 1 ? " thread" : " threads") << ")\n"
-            << "energy       kinetic " << s.energy.kinetic << ", strain " << s.energy.strain
+  if (s.newton) {
+    const NewtonStatistics& n = *s.newton;
+    std::cout << "\nNewton       " << n.loadSteps << " load steps, " << n.iterations
+              << " iterations";
+    if (n.krylovIterations > 0) std::cout << ", " << n.krylovIterations << " CG iterations";
+    std::cout << ", " << n.factorisations << " factorisations (" << n.linearSolver << ", "
+              << n.nonZeros << " stored entries); wall " << s.wallSeconds << " s: assembly "
+              << n.assemblySeconds << ", factorisation " << n.factorisationSeconds << ", solves "
+              << n.solveSeconds << " (" << threads << (threads == 1 ? " thread" : " threads")
+              << ")\n";
+  } else {
+    std::cout << "\nsteps " << s.steps << ", simulated " << s.time << " s, wall " << s.wallSeconds
+              << " s (" << double(setup.scene.particles.size()) * s.steps / s.wallSeconds
+              << " particle-steps/s, " << threads << (threads == 1 ? " thread" : " threads")
+              << ")\n";
+  }
+  std::cout << "energy       kinetic " << s.energy.kinetic << ", strain " << s.energy.strain
             << ", hourglass " << s.energy.hourglass << ", external work " << s.energy.externalWork
             << ", damped " << s.energy.damped << "\n";
   if (!s.pvd.empty()) std::cout << "wrote        " << s.pvd.string() << "\n";
@@ -203,6 +222,10 @@ int runOrCheck(const Config& config, bool run, bool progress, const std::string&
       std::cout << "converged: residual " << s.residual << " < " << setup.run.tolerance << "\n";
       return 0;
     case RunOutcome::NotConverged:
+      if (s.newton) {
+        std::cout << "NOT converged (Newton): residual " << s.residual << "\n";
+        return 3;
+      }
       std::cout << "NOT converged: residual " << s.residual << " >= " << setup.run.tolerance
                 << " at the end time; raise [time] end or the damping\n";
       return 3;

@@ -635,17 +635,39 @@ class Builder {
     setup_.run.quasiStatic = s.flag("enabled", config_.hasSection("static"));
     setup_.run.tolerance = s.positive("tolerance", 1e-5);
     setup_.run.checkEvery = std::max(1L, s.integer("check_every", 50));
+    const bool newton = s.word("solver", "damped", {"damped", "newton"}) == "newton";
+    setup_.run.staticSolver =
+        newton ? RunSettings::StaticSolver::Newton : RunSettings::StaticSolver::Damped;
+    auto& n = setup_.run.newton;
+    n.tolerance = setup_.run.tolerance;
+    n.loadSteps = static_cast<int>(s.integer("load_steps", 1));
+    if (n.loadSteps < 1 || n.loadSteps > 100000)
+      throw s.error("load_steps",
+                    "must be between 1 and 100000, got " + config_.get("static", "load_steps"));
+    n.maxIterations = static_cast<int>(s.integer("max_iterations", 30));
+    if (n.maxIterations < 1)
+      throw s.error("max_iterations",
+                    "must be at least 1, got " + config_.get("static", "max_iterations"));
     s.finish();
     SectionReader t(config_, "time");
     setup_.solver.cfl = t.positive("cfl", kDefaultCfl);
     setup_.solver.timeStep = t.nonNegative("dt", 0.0);
-    setup_.run.endTime = t.positive("end");
+    // A Newton static run has no time to march; `end` only scales the default output interval.
+    setup_.run.endTime =
+        newton && setup_.run.quasiStatic ? t.positive("end", 1.0) : t.positive("end");
     setup_.run.maxSteps = t.integer("max_steps", 0);
     t.finish();
+    if (setup_.run.quasiStatic && newton && setup_.scene.hourglassCoefficient != 0.0 &&
+        setup_.scene.hourglassForm != HourglassForm::Energy)
+      throw InputError(config_.origin(), "static", "solver",
+                       "solver = newton needs the hourglass penalty's energy form ([hourglass] "
+                       "form = energy): the textbook force (6.80)-(6.81) is not the gradient of "
+                       "an energy and has no symmetric tangent");
     if (setup_.run.quasiStatic) {
-      if (!setup_.scene.damping.any())
+      if (!newton && !setup_.scene.damping.any())
         throw InputError(config_.origin(), "static", "enabled",
-                         "a static run needs damping: set [damping] kinetic = true or viscous > 0");
+                         "a static run needs damping: set [damping] kinetic = true or viscous > 0, "
+                         "or solve it with [static] solver = newton");
       if (setup_.scene.prescriptions.empty() && setup_.scene.mirrorGhosts.empty())
         throw InputError(config_.origin(), "static", "enabled",
                          "a static run needs the body held: add a [clamp.NAME] or a "

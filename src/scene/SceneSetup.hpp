@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "tlsph/NewtonSolver.hpp"
 #include "tlsph/Scene.hpp"
 #include "tlsph/Solver.hpp"
 
@@ -17,6 +18,12 @@ struct RunSettings {
   bool quasiStatic = false;
   double tolerance = 1e-4;  // out-of-balance force ratio at which a static run has converged
   long checkEvery = 50;     // steps between convergence and stability checks
+  // How a static run finds equilibrium: explicit dynamics with damping until the residual is
+  // small (damped), or Newton-Raphson on the tangent stiffness with load steps (newton).
+  enum class StaticSolver { Damped, Newton };
+  StaticSolver staticSolver = StaticSolver::Damped;
+  NewtonSettings newton;
+  bool newtonStatic() const { return quasiStatic && staticSolver == StaticSolver::Newton; }
 };
 
 struct OutputSettings {

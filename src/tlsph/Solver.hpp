@@ -249,6 +249,69 @@ class Solver {
     return R;
   }
 
+  // The particles the integrator moves (the unknowns of a static solve).
+  const std::vector<Index>& freeParticles() const {
+    return free_;
+  }
+
+  // Internal plus external force on particle i at the last evaluation (for a free particle,
+  // with the forces of the mirrored ghosts that follow it): the out-of-balance force.
+  Vec<D> netForce(Index i) const {
+    return totalForce(i);
+  }
+
+  // Puts the scene in the static state of load time t, for solvers that find equilibrium
+  // directly (NewtonSolver): prescribed particles and moving mirrored faces at their
+  // displacements at t, loads and body forces at t, velocities zero, forces recomputed for the
+  // free particles' present displacements. Counts as one step; the work of the loads and
+  // prescribed particles since the previous state is booked with the trapezoidal rule when
+  // finishStaticStep() is called once the free particles have settled. The first static step
+  // starts from the unloaded state (no loads, no reactions): the loads are applied from zero,
+  // so for a linear problem the books close exactly (Clapeyron).
+  void beginStaticStep(double t) {
+    const auto& p = scene_.particles;
+    staticStart_ = p.displacement;
+    staticForce_ = p.force;
+    staticExternal_ = external_;
+    staticDrive_ = drive_;
+    staticTime_ = time_;
+    staticFromZero_ = !staticBooksStarted_;
+    if (staticFromZero_) {
+      for (auto& f : staticForce_)
+        f.setZero();
+      for (auto& f : staticExternal_)
+        f.setZero();
+      staticBooksStarted_ = true;
+    }
+    moveToStaticTime(t);
+    ++steps_;
+  }
+
+  // Undoes a static step that did not converge: back to the state beginStaticStep() saved.
+  void abandonStaticStep() {
+    scene_.particles.displacement = staticStart_;
+    moveToStaticTime(staticTime_);
+    if (staticFromZero_) staticBooksStarted_ = false;
+    --steps_;
+  }
+
+  void finishStaticStep() {
+    const auto& p = scene_.particles;
+    double external = 0.0, boundary = 0.0;
+    for (Index i : free_)
+      if (hasExternal_)
+        external +=
+            0.5 * (staticExternal_[i] + external_[i]).dot(p.displacement[i] - staticStart_[i]);
+    for (Index i : prescribed_)
+      boundary -= 0.5 * (staticForce_[i] + p.force[i]).dot(p.displacement[i] - staticStart_[i]);
+    for (std::size_t k = 0; k < staticDrive_.size(); ++k) {
+      const Index g = scene_.mirrorGhosts[k].ghost;
+      boundary -= 0.5 * (staticForce_[g] + p.force[g]).dot(drive_[k] - staticDrive_[k]);
+    }
+    externalWork_ += external;
+    boundaryWork_ += boundary;
+  }
+
   // Recomputes the forces (and the external forces at the current time) for the particles'
   // present displacements and velocities, without advancing: for a state put back from a
   // copy, e.g. to write the last good frame of a run that went unstable.
@@ -385,6 +448,36 @@ class Solver {
     return p.displacement[i];
   }
 
+  void moveToStaticTime(double t) {
+    auto& p = scene_.particles;
+    time_ = t;
+    for (std::size_t k = 0; k < prescribed_.size(); ++k)
+      p.displacement[prescribed_[k]] = staticPrescribedDisplacement(k, t);
+    for (auto& v : p.velocity)
+      v.setZero();
+    if (movingMirrors_) {
+      updateMirrorDrive(t);
+      for (auto& r : driveRate_)
+        r.setZero();
+    }
+    reevaluate();
+  }
+
+  // Displacement of prescribed particle k at load time t of a static solve (exact for every
+  // rule: a velocity rule's displacement is its integral from 0).
+  Vec<D> staticPrescribedDisplacement(std::size_t k, double t) const {
+    const Index i = prescribed_[k];
+    const auto& p = scene_.particles;
+    if (rule_[k] < 0) return start_[k];
+    const auto& rule = scene_.prescriptions[rule_[k]];
+    if (rule.motion == PrescribedMotion::Rotation) {
+      const Vec<D>& X = p.referencePosition[i];
+      const Mat<D> R = rotationMatrix<D>(rule.axis, rampedAngle(rule.rate, rule.ramp, t));
+      return Vec<D>(rule.point + R * (X + start_[k] - rule.point) - X);
+    }
+    return Vec<D>(start_[k] + prescribedDisplacementAt(rule, p.referencePosition[i], t));
+  }
+
   Vec<D> prescribedVelocity(std::size_t k, double t) const {
     const auto& p = scene_.particles;
     if (rule_[k] < 0) return p.velocity[prescribed_[k]];
@@ -426,6 +519,10 @@ class Solver {
   double externalWork_ = 0.0;
   double boundaryWork_ = 0.0;
   double damped_ = 0.0;
+  // State at the start of a static step (beginStaticStep), for its work books.
+  std::vector<Vec<D>> staticStart_, staticForce_, staticExternal_, staticDrive_;
+  double staticTime_ = 0.0;
+  bool staticBooksStarted_ = false, staticFromZero_ = false;
 };
 
 }  // namespace tlsph

@@ -1,0 +1,236 @@
+// TangentStiffness (see the header): the linearised force pass, the assembly and its pattern.
+// Compiled once for 2D and 3D.
+#include "tlsph/TangentStiffness.hpp"
+
+namespace tlsph {
+
+template <int D>
+void TangentStiffness<D>::update(const std::vector<Mat<D>>& F) {
+  for (std::size_t m = 0; m < materials_.size(); ++m)
+    std::visit(
+        [&](const auto& model) {
+          const auto& group = groups_[m];
+          const Index count = static_cast<Index>(group.size());
+#pragma omp parallel for schedule(static)
+          for (Index p = 0; p < count; ++p)
+            modulus_[group[p]] = tangentModulus<D>(model, F[group[p]]);
+        },
+        materials_[m]);
+}
+
+template <int D>
+void TangentStiffness<D>::apply(const Eigen::VectorXd& v, Eigen::VectorXd& Kv) {
+  const auto& nb = ref_.neighbours;
+  dofs_.expand(v, full_);
+#pragma omp parallel for schedule(static)
+  for (Index i = 0; i < n_; ++i) {
+    const Vec<D> vi = full_[i];
+    Mat<D> dH = Mat<D>::Zero(), dHh = Mat<D>::Zero();
+    for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
+      const Vec<D> dv = full_[nb.neighbour[k]] - vi;
+      dH.noalias() += dv * ref_.correctedGradient[k].transpose();  // (6.69), linearised
+      if (separate_) dHh.noalias() += dv * ref_.linearGradient[k].transpose();
+    }
+    dF_[i] = Mat<D>::Identity() + dH;  // 1 + dF: what the penalty's evaluate() expects
+    if (separate_) hourglassH_[i] = Mat<D>::Identity() + dHh;
+    if (hasEnergy_[i]) {
+      Eigen::Map<Eigen::Matrix<double, DD, 1>>(dS_[i].data()) =
+          modulus_[i] * Eigen::Map<const Eigen::Matrix<double, DD, 1>>(dH.data());  // A : dF
+    } else {
+      dS_[i].setZero();
+    }
+  }
+  const std::vector<Mat<D>>* S = &dS_;
+  if (penalty_) {
+    // E_hg is quadratic in u: its force at v is K_hg v.
+    if (separate_) {
+      penalty_->evaluate(full_, hourglassH_, nullptr, penaltyStress_);
+    } else {
+      penalty_->evaluate(full_, dF_, &dS_, penaltyStress_);
+      S = &penaltyStress_;
+    }
+  }
+#pragma omp parallel for schedule(static)
+  for (Index i = 0; i < n_; ++i) {
+    const auto& St = *S;
+    // f_I = V_I (S_I G_I - sum_J S_J t_IJ), linearised
+    Vec<D> f = St[i] * ref_.correctedGradientSum[i];
+    if (separate_) f += penaltyStress_[i] * linearSum_[i];
+    for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
+      f.noalias() -= St[nb.neighbour[k]] * ref_.reverseGradient[k];
+      if (separate_) f.noalias() -= penaltyStress_[nb.neighbour[k]] * linearReverse_[k];
+    }
+    df_[i] = volume_[i] * f;
+    if (penalty_) df_[i] += penalty_->springForce(i);
+  }
+  dofs_.gather(df_, Kv);
+  Kv = -Kv;
+}
+
+template <int D>
+const typename TangentStiffness<D>::SparseMatrix& TangentStiffness<D>::assemble() {
+  if (matrix_.rows() == 0) buildPattern();
+  std::fill(matrix_.valuePtr(), matrix_.valuePtr() + matrix_.nonZeros(), 0.0);
+  const auto& nb = ref_.neighbours;
+#pragma omp parallel
+  {
+    Stencil s;
+    std::vector<Eigen::Matrix<double, DD, D>> AB;
+    Eigen::MatrixXd C, CK;
+#pragma omp for schedule(dynamic, 64)
+    for (Index i = 0; i < n_; ++i) {
+      reducedStencil(i, s);
+      const Index m = static_cast<Index>(s.dof.size());
+      if (m == 0) continue;
+      // local(p, q) blocks, p >= q in dof order (the stencil is sorted by dof)
+      if (hasEnergy_[i]) {
+        AB.resize(m);
+        for (Index q = 0; q < m; ++q)
+          AB[q] = modulus_[i] * kroneckerIdentity(s.b[q]);  // A B_q
+      }
+      const bool penalty = penalty_ != nullptr;
+      const Index count = nb.offset[i + 1] - nb.offset[i];
+      if (penalty) {
+        // C(p, J) = coefficient of u_p in r_IJ = u_I - u_J - H_I X_IJ (reduced).
+        C.setZero(m, count);
+        for (Index p = 0; p < m; ++p)
+          for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k)
+            C(p, k - nb.offset[i]) = s.self[p] - s.bh[p].dot(ref_.separation[k]);
+        for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
+          auto [t, end] = dofs_.terms(nb.neighbour[k]);
+          for (; t != end; ++t)
+            C(s.position(t->dof), k - nb.offset[i]) -= t->weight;
+        }
+        CK = C;
+        for (Index k = 0; k < count; ++k)
+          CK.col(k) *= 0.5 * volume_[i] * c_[nb.offset[i] + k];  // 1/2 k_IJ
+      }
+      for (Index q = 0; q < m; ++q)
+        for (Index p = q; p < m; ++p) {
+          Mat<D> block = Mat<D>::Zero();
+          if (hasEnergy_[i]) {
+            for (int j = 0; j < D; ++j)
+              block.noalias() += s.b[p][j] * AB[q].template middleRows<D>(D * j);
+            block *= volume_[i];
+          }
+          if (penalty) block.diagonal().array() += CK.row(p).dot(C.row(q));
+          addBlock(s.dof[p], s.dof[q], block);
+        }
+    }
+  }
+  return matrix_;
+}
+
+template <int D>
+void TangentStiffness<D>::reducedStencil(Index i, Stencil& s) const {
+  const auto& nb = ref_.neighbours;
+  s.clear();
+  auto add = [&](Index particle, const Vec<D>& b, const Vec<D>& bh, bool self) {
+    auto [t, end] = dofs_.terms(particle);
+    for (; t != end; ++t) {
+      auto at = std::find(s.dof.begin(), s.dof.end(), t->dof);
+      std::size_t p = at - s.dof.begin();
+      if (at == s.dof.end()) {
+        s.dof.push_back(t->dof);
+        s.b.push_back(Vec<D>::Zero());
+        s.bh.push_back(Vec<D>::Zero());
+        s.self.push_back(0.0);
+      }
+      s.b[p] += t->weight * b;
+      s.bh[p] += t->weight * bh;
+      if (self) s.self[p] += t->weight;
+    }
+  };
+  const bool linear = separate_;
+  Vec<D> Gh = Vec<D>::Zero();
+  if (linear)
+    for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k)
+      Gh += ref_.linearGradient[k];
+  else
+    Gh = ref_.correctedGradientSum[i];
+  add(i, -ref_.correctedGradientSum[i], -Gh, true);
+  for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k)
+    add(nb.neighbour[k], ref_.correctedGradient[k],
+        linear ? ref_.linearGradient[k] : ref_.correctedGradient[k], false);
+  // sort by dof
+  std::vector<Index> order(s.dof.size());
+  for (std::size_t k = 0; k < order.size(); ++k)
+    order[k] = static_cast<Index>(k);
+  std::sort(order.begin(), order.end(), [&](Index a, Index b) { return s.dof[a] < s.dof[b]; });
+  Stencil sorted;
+  for (Index k : order) {
+    sorted.dof.push_back(s.dof[k]);
+    sorted.b.push_back(s.b[k]);
+    sorted.bh.push_back(s.bh[k]);
+    sorted.self.push_back(s.self[k]);
+  }
+  s = std::move(sorted);
+}
+
+template <int D>
+typename TangentStiffness<D>::Kronecker TangentStiffness<D>::kroneckerIdentity(const Vec<D>& b) {
+  Eigen::Matrix<double, DD, D> B = Eigen::Matrix<double, DD, D>::Zero();
+  for (int j = 0; j < D; ++j)
+    B.template middleRows<D>(D * j).diagonal().setConstant(b[j]);
+  return B;
+}
+
+template <int D>
+void TangentStiffness<D>::buildPattern() {
+  const Index nd = dofs_.size();
+  std::vector<std::vector<Index>> rows(nd);
+  Stencil s;
+  for (Index i = 0; i < n_; ++i) {
+    reducedStencil(i, s);
+    for (std::size_t q = 0; q < s.dof.size(); ++q)
+      for (std::size_t p = q; p < s.dof.size(); ++p)
+        rows[s.dof[q]].push_back(s.dof[p]);
+  }
+  blockStart_.assign(nd + 1, 0);
+  blockRows_.clear();
+  for (Index q = 0; q < nd; ++q) {
+    auto& r = rows[q];
+    std::sort(r.begin(), r.end());
+    r.erase(std::unique(r.begin(), r.end()), r.end());
+    blockStart_[q + 1] = blockStart_[q] + static_cast<Index>(r.size());
+    blockRows_.insert(blockRows_.end(), r.begin(), r.end());
+    std::vector<Index>().swap(r);
+  }
+  const Index size = D * nd;
+  matrix_.resize(size, size);
+  matrix_.resizeNonZeros(static_cast<Eigen::Index>(blockStart_[nd]) * DD);
+  int* outer = matrix_.outerIndexPtr();
+  int* inner = matrix_.innerIndexPtr();
+  for (Index q = 0; q < nd; ++q) {
+    const Index L = blockStart_[q + 1] - blockStart_[q];
+    for (int k = 0; k < D; ++k) {
+      const Index start = blockStart_[q] * DD + k * D * L;
+      outer[D * q + k] = start;
+      for (Index r = 0; r < L; ++r)
+        for (int i = 0; i < D; ++i)
+          inner[start + D * r + i] = D * blockRows_[blockStart_[q] + r] + i;
+    }
+  }
+  outer[size] = blockStart_[nd] * DD;
+}
+
+template <int D>
+void TangentStiffness<D>::addBlock(Index p, Index q, const Mat<D>& block) {
+  const auto first = blockRows_.begin() + blockStart_[q];
+  const auto last = blockRows_.begin() + blockStart_[q + 1];
+  const Index r = static_cast<Index>(std::lower_bound(first, last, p) - first);
+  const Index L = blockStart_[q + 1] - blockStart_[q];
+  double* values = matrix_.valuePtr();
+  for (int k = 0; k < D; ++k) {
+    const Index start = blockStart_[q] * DD + k * D * L + D * r;
+    for (int i = 0; i < D; ++i) {
+#pragma omp atomic
+      values[start + i] += block(i, k);
+    }
+  }
+}
+
+template class TangentStiffness<2>;
+template class TangentStiffness<3>;
+
+}  // namespace tlsph
