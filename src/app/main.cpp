@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "app/CompareCommand.hpp"
+#include "app/ModesCommand.hpp"
 #include "app/RunRecord.hpp"
 #include "app/RunSimulation.hpp"
 #include "scene/Config.hpp"
@@ -31,6 +32,9 @@ constexpr const char* kUsage = R"(tlsph - total-Lagrangian SPH for elastic solid
 usage:
   tlsph run   SCENE.ini [--section.key=value ...]   run a scene
   tlsph check SCENE.ini [--section.key=value ...]   validate and print the set-up, do not run
+  tlsph modes SCENE.ini [--count=N] [--about=final] [--section.key=value ...]
+                                                    lowest natural modes, zero-energy modes
+                                                    and their hourglass content (docs/modes.md)
   tlsph compare RUN FEM.vtu [options]               errors against an FEM solution, field by
                                                     field (tlsph compare --help)
   tlsph --help | --version
@@ -46,7 +50,7 @@ run options:
 exit status: 0 finished (or a static run converged), 1 bad input or set-up, 3 a static
 run did not converge, 4 the run went unstable (a [guard] check failed: the message names
 step, particle, quantity and likely cause; NAME_last_good.vtu and NAME_failed.vtu are
-written).
+written), 5 (modes) zero-energy modes other than rigid-body motions.
 )";
 
 using namespace tlsph;
@@ -260,9 +264,9 @@ int main(int argc, char** argv) {
   }
   const std::string verb = args[0];
   if (verb == "compare") return runCompare({args.begin() + 1, args.end()});
-  if ((verb != "run" && verb != "check") || args.size() < 2) {
-    std::cerr << "tlsph: expected 'run SCENE.ini', 'check SCENE.ini' or 'compare RUN FEM.vtu'; "
-                 "see tlsph --help\n";
+  if ((verb != "run" && verb != "check" && verb != "modes") || args.size() < 2) {
+    std::cerr << "tlsph: expected 'run SCENE.ini', 'check SCENE.ini', 'modes SCENE.ini' or "
+                 "'compare RUN FEM.vtu'; see tlsph --help\n";
     return 1;
   }
   const char* ci = std::getenv("CI");
@@ -271,17 +275,46 @@ int main(int argc, char** argv) {
   std::string command = "tlsph";
   for (const auto& a : args)
     command += " " + a;
+  ModesOptions modes;
   for (std::size_t k = 2; k < args.size(); ++k) {
-    if (args[k] == "--progress")
+    if (args[k] == "--progress") {
       progress = true;
-    else if (args[k] == "--no-progress")
+    } else if (args[k] == "--no-progress") {
       progress = false;
-    else
+    } else if (verb == "modes" && args[k].rfind("--count=", 0) == 0) {
+      const std::string value = args[k].substr(8);
+      char* end = nullptr;
+      const long count = std::strtol(value.c_str(), &end, 10);
+      if (value.empty() || *end != '\0' || count < 1 || count > 10000) {
+        std::cerr << "tlsph: modes: --count expects a whole number from 1 to 10000, got '" << value
+                  << "'\n";
+        return 1;
+      }
+      modes.settings.count = static_cast<int>(count);
+    } else if (verb == "modes" && args[k].rfind("--about=", 0) == 0) {
+      const std::string value = args[k].substr(8);
+      if (value != "reference" && value != "final") {
+        std::cerr << "tlsph: modes: --about expects reference or final, got '" << value << "'\n";
+        return 1;
+      }
+      modes.aboutFinalState = value == "final";
+    } else {
       overrides.push_back(args[k]);
+    }
   }
   try {
     const Config config = Config::read(args[1], overrides);
     const int d = sceneDimension(config);
+    if (verb == "modes") {
+      modes.run.command = command;
+      modes.run.progress = progress;
+      if (d == 2) {
+        SceneSetup<2> setup = buildScene<2>(config);
+        return runModes<2>(setup, modes);
+      }
+      SceneSetup<3> setup = buildScene<3>(config);
+      return runModes<3>(setup, modes);
+    }
     return d == 2 ? runOrCheck<2>(config, verb == "run", progress, command)
                   : runOrCheck<3>(config, verb == "run", progress, command);
   } catch (const InputError& e) {

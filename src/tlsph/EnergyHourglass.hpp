@@ -39,6 +39,9 @@ class EnergyHourglass {
   // penalty compares with; P^hg must go through that F's gradient vectors.
   // With H = F - 1, e_IJ = (u_I - u_J) - 1/2 H_I X_IJ - 1/2 H_J X_IJ; the H_I part is summed
   // once per particle through the constant moments sum_J c_IJ X_IJ and sum_J c_IJ X_IJ X_IJ^T.
+  // With Gradient = true, F holds the displacement gradients H = F - 1 themselves (the
+  // tangent's linearised pass, where 1 + dH would round dH off).
+  template <bool Gradient = false>
   void evaluate(const std::vector<Vec<D>>& u, const std::vector<Mat<D>>& F,
                 const std::vector<Mat<D>>* P, std::vector<Mat<D>>& stress) {
     const auto& nb = ref_.neighbours;
@@ -51,12 +54,12 @@ class EnergyHourglass {
       for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
         const Index j = nb.neighbour[k];
         const Vec<D>& Xij = ref_.separation[k];
-        const Vec<D> HjX = F[j] * Xij - Xij;
+        const Vec<D> HjX = Gradient ? Vec<D>(F[j] * Xij) : Vec<D>(F[j] * Xij - Xij);
         const Vec<D> w = c_[k] * ((ui - u[j]) - 0.5 * HjX);
         sum += w;
         moment.noalias() += w * Xij.transpose();
       }
-      const Mat<D> Hi = F[i] - Mat<D>::Identity();
+      const Mat<D> Hi = Gradient ? F[i] : Mat<D>(F[i] - Mat<D>::Identity());
       sum -= 0.5 * (Hi * sumCX_[i]);                // sum_J c_IJ e_IJ
       moment.noalias() -= 0.5 * (Hi * sumCXX_[i]);  // sum_J c_IJ e_IJ (x) X_IJ
       stress[i] = P ? Mat<D>((*P)[i] - 0.5 * moment) : Mat<D>(-0.5 * moment);  // P + P^hg

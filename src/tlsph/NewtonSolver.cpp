@@ -1,6 +1,8 @@
 // NewtonSolver (see the header), compiled once for 2D and 3D.
 #include "tlsph/NewtonSolver.hpp"
 
+#include "tlsph/ConjugateGradients.hpp"
+
 namespace tlsph {
 
 template <int D>
@@ -110,44 +112,26 @@ bool NewtonSolver<D>::solveLinear(const Eigen::VectorXd& r, Eigen::VectorXd& du,
   const double target =
       std::max(settings_.linearTolerance * r.norm(), 0.1 * settings_.tolerance * forceScale);
   du = factor_.solve(r);
-  Eigen::VectorXd res = r, Kp(r.size());
-  tangent_.apply(du, Kp);
-  res -= Kp;
-  Eigen::VectorXd z = factor_.solve(res), p = z;
-  double rz = res.dot(z);
-  int iterations = 0;
-  double earlier = res.norm();  // the residual kStall iterations ago
-  for (; iterations < kMaxKrylov && res.norm() > target; ++iterations) {
-    // Near round-off the residual stops falling: stop there rather than run to the limit.
-    if (iterations > 0 && iterations % kStall == 0) {
-      if (res.norm() > 0.5 * earlier) break;
-      earlier = res.norm();
-    }
-    tangent_.apply(p, Kp);
-    const double curvature = p.dot(Kp);
-    if (!(curvature > 0.0)) {
-      why =
-          "the tangent stiffness is not positive definite along a search direction "
-          "(buckling or a material instability)";
-      return false;
-    }
-    const double a = rz / curvature;
-    du += a * p;
-    res -= a * Kp;
-    z = factor_.solve(res);
-    const double rzNew = res.dot(z);
-    p = z + (rzNew / rz) * p;
-    rz = rzNew;
-  }
+  const ConjugateGradientResult cg = conjugateGradients(
+      [&](const Eigen::VectorXd& v, Eigen::VectorXd& Kv) { tangent_.apply(v, Kv); },
+      [&](const Eigen::VectorXd& v) { return factor_.solve(v); }, r, du, target, kMaxKrylov,
+      kStall);
+  const int iterations = cg.iterations;
   statistics_.krylovIterations += iterations;
   statistics_.solveSeconds += seconds(t0);
   lastKrylov_ = iterations;
+  if (cg.negativeCurvature) {
+    why =
+        "the tangent stiffness is not positive definite along a search direction "
+        "(buckling or a material instability)";
+    return false;
+  }
   // Round-off can stall the iteration short of a tight target; a direction that has halved
   // the residual still serves Newton.
-  if (res.norm() > target && res.norm() > 0.5 * r.norm()) {
+  if (cg.residual > target && cg.residual > 0.5 * r.norm()) {
     std::ostringstream msg;
     msg << "the linear solve stalled after " << iterations
-        << " conjugate-gradient iterations at an out-of-balance force of " << res.norm()
+        << " conjugate-gradient iterations at an out-of-balance force of " << cg.residual
         << " (the Newton target is " << settings_.tolerance * forceScale
         << "): below the round-off of this discretisation, or the preconditioner is poor";
     why = msg.str();

@@ -19,7 +19,7 @@ void TangentStiffness<D>::update(const std::vector<Mat<D>>& F) {
 }
 
 template <int D>
-void TangentStiffness<D>::apply(const Eigen::VectorXd& v, Eigen::VectorXd& Kv) {
+void TangentStiffness<D>::apply(const Eigen::VectorXd& v, Eigen::VectorXd& Kv, Part part) {
   const auto& nb = ref_.neighbours;
   dofs_.expand(v, full_);
 #pragma omp parallel for schedule(static)
@@ -31,9 +31,9 @@ void TangentStiffness<D>::apply(const Eigen::VectorXd& v, Eigen::VectorXd& Kv) {
       dH.noalias() += dv * ref_.correctedGradient[k].transpose();  // (6.69), linearised
       if (separate_) dHh.noalias() += dv * ref_.linearGradient[k].transpose();
     }
-    dF_[i] = Mat<D>::Identity() + dH;  // 1 + dF: what the penalty's evaluate() expects
-    if (separate_) hourglassH_[i] = Mat<D>::Identity() + dHh;
-    if (hasEnergy_[i]) {
+    dF_[i] = dH;  // the penalty takes the gradient itself (1 + dH would round dH off)
+    if (separate_) hourglassH_[i] = dHh;
+    if (hasEnergy_[i] && part != Part::Penalty) {
       Eigen::Map<Eigen::Matrix<double, DD, 1>>(dS_[i].data()) =
           modulus_[i] * Eigen::Map<const Eigen::Matrix<double, DD, 1>>(dH.data());  // A : dF
     } else {
@@ -41,12 +41,13 @@ void TangentStiffness<D>::apply(const Eigen::VectorXd& v, Eigen::VectorXd& Kv) {
     }
   }
   const std::vector<Mat<D>>* S = &dS_;
-  if (penalty_) {
+  const bool penalty = penalty_ && part != Part::Strain;
+  if (penalty) {
     // E_hg is quadratic in u: its force at v is K_hg v.
     if (separate_) {
-      penalty_->evaluate(full_, hourglassH_, nullptr, penaltyStress_);
+      penalty_->template evaluate<true>(full_, hourglassH_, nullptr, penaltyStress_);
     } else {
-      penalty_->evaluate(full_, dF_, &dS_, penaltyStress_);
+      penalty_->template evaluate<true>(full_, dF_, &dS_, penaltyStress_);
       S = &penaltyStress_;
     }
   }
@@ -55,13 +56,14 @@ void TangentStiffness<D>::apply(const Eigen::VectorXd& v, Eigen::VectorXd& Kv) {
     const auto& St = *S;
     // f_I = V_I (S_I G_I - sum_J S_J t_IJ), linearised
     Vec<D> f = St[i] * ref_.correctedGradientSum[i];
-    if (separate_) f += penaltyStress_[i] * linearSum_[i];
+    const bool linearPenalty = separate_ && penalty;
+    if (linearPenalty) f += penaltyStress_[i] * linearSum_[i];
     for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
       f.noalias() -= St[nb.neighbour[k]] * ref_.reverseGradient[k];
-      if (separate_) f.noalias() -= penaltyStress_[nb.neighbour[k]] * linearReverse_[k];
+      if (linearPenalty) f.noalias() -= penaltyStress_[nb.neighbour[k]] * linearReverse_[k];
     }
     df_[i] = volume_[i] * f;
-    if (penalty_) df_[i] += penalty_->springForce(i);
+    if (penalty) df_[i] += penalty_->springForce(i);
   }
   dofs_.gather(df_, Kv);
   Kv = -Kv;
@@ -227,6 +229,17 @@ void TangentStiffness<D>::addBlock(Index p, Index q, const Mat<D>& block) {
 #pragma omp atomic
       values[start + i] += block(i, k);
     }
+  }
+}
+
+template <int D>
+void TangentStiffness<D>::addToDiagonal(const Eigen::VectorXd& d) {
+  // The diagonal block (q, q) is the first block row of block column q.
+  double* values = matrix_.valuePtr();
+  for (Index q = 0; q < dofs_.size(); ++q) {
+    const Index L = blockStart_[q + 1] - blockStart_[q];
+    for (int k = 0; k < D; ++k)
+      values[blockStart_[q] * DD + k * D * L + k] += d[D * q + k];
   }
 }
 

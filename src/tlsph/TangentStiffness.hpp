@@ -76,12 +76,12 @@ class TangentStiffness {
         for (Index i = 0; i < n_; ++i)
           for (Index k = ref.neighbours.offset[i]; k < ref.neighbours.offset[i + 1]; ++k)
             linearSum_[i] += ref.linearGradient[k];
-        hourglassH_.assign(n_, Mat<D>::Identity());
+        hourglassH_.assign(n_, Mat<D>::Zero());
       }
       penaltyStress_.assign(n_, Mat<D>::Zero());
     }
     full_.assign(n_, Vec<D>::Zero());
-    dF_.assign(n_, Mat<D>::Identity());
+    dF_.assign(n_, Mat<D>::Zero());
     dS_.assign(n_, Mat<D>::Zero());
     df_.assign(n_, Vec<D>::Zero());
   }
@@ -95,11 +95,16 @@ class TangentStiffness {
   void update(const std::vector<Mat<D>>& F);
 
   // Kv = K v, exactly (v and Kv: D values per unknown, stacked).
-  void apply(const Eigen::VectorXd& v, Eigen::VectorXd& Kv);
+  // Which part of K a product takes: all of it, the strain energy's, or the penalty's.
+  enum class Part { All, Strain, Penalty };
+  void apply(const Eigen::VectorXd& v, Eigen::VectorXd& Kv, Part part = Part::All);
 
   // The sparse matrix described at the top, lower triangle only (use selfadjointView<Lower>).
   // The pattern is built on the first call.
   const SparseMatrix& assemble();
+  // Adds d (one value per unknown) to the diagonal of the last assembled matrix, e.g. -sigma
+  // times the masses for the shifted matrix K - sigma M of a modal analysis.
+  void addToDiagonal(const Eigen::VectorXd& d);
 
  private:
   // Particle I's stencil {I} + N(I) expressed on the unknowns: per unknown p (sorted),
@@ -146,7 +151,7 @@ class TangentStiffness {
   std::vector<Vec<D>> linearReverse_, linearSum_;
   std::vector<Mat<D>> hourglassH_, penaltyStress_;
   std::vector<Vec<D>> full_, df_;
-  std::vector<Mat<D>> dF_, dS_;
+  std::vector<Mat<D>> dF_, dS_;  // per particle: dH = dF and A : dH
   std::vector<Index> blockStart_, blockRows_;
   SparseMatrix matrix_;
 };
