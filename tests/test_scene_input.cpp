@@ -160,7 +160,8 @@ TEST(SceneInput, ThinClampIsRejected) {
 }
 
 TEST(SceneInput, ExamplesBuild) {
-  for (const char* name : {"cantilever", "oscillating_plate", "clamped_plate"}) {
+  for (const char* name :
+       {"cantilever", "oscillating_plate", "clamped_plate", "hourglass_block", "hourglass_beam"}) {
     const std::string path = std::string(TLSPH_SOURCE_DIR) + "/examples/" + name + ".ini";
     const Config config = Config::read(path);
     if (sceneDimension(config) == 2)
@@ -271,4 +272,29 @@ TEST(SceneInput, HolesRemoveParticles) {
     EXPECT_GT((setup.scene.particles.referencePosition[i] - Vec<2>(0.1, 0.02)).norm(), 0.011);
   expectError(errorOf(kGood + "[hole.h]\nshape = half-space\npoint = 0 0\nnormal = 1 0\n"),
               {"[hole.h]", "shape", "'half-space'"});
+}
+
+TEST(SceneInput, RandomInitialVelocityIsSeededAndBounded) {
+  auto velocities = [](const std::string& seed, const std::string& amplitude = "0.5") {
+    const SceneSetup<2> s = buildScene<2>(Config::parse(
+        kGood + "[initial.kick]\nprofile = random\namplitude = " + amplitude + "\n" + seed,
+        "scene.ini"));
+    return s.scene.particles.velocity;
+  };
+  const auto a = velocities("seed = 7\n"), b = velocities("seed = 7\n"),
+             c = velocities("seed = 8\n");
+  ASSERT_EQ(a.size(), b.size());
+  double largest = 0.0, mean = 0.0;
+  bool differs = false;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i], b[i]);  // same seed, same field
+    differs = differs || a[i] != c[i];
+    largest = std::max(largest, a[i].cwiseAbs().maxCoeff());
+    mean += a[i].x();
+  }
+  EXPECT_TRUE(differs);
+  EXPECT_LE(largest, 0.5);
+  EXPECT_GT(largest, 0.4);  // the components fill [-0.5, 0.5]
+  EXPECT_LT(std::abs(mean / a.size()), 0.1);
+  EXPECT_THROW(velocities("seed = 1\n", "0"), InputError);
 }

@@ -112,9 +112,11 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
   const std::vector<std::string> preamble = {
       "tlsph scene " + setup.name + " from " + setup.sourceFile, "command: " + options.command,
       "SI units: s, m, J, kg m/s"};
-  CsvSeries energies(dir / "energies.csv", {"time", "step", "kinetic", "strain", "hourglass",
-                                            "external_work", "boundary_work", "damped", "total",
-                                            "residual", "momentum_x", "momentum_y", "momentum_z"});
+  std::vector<std::string> energyColumns = {
+      "time",   "step",  "kinetic",  "strain",     "hourglass",  "external_work", "boundary_work",
+      "damped", "total", "residual", "momentum_x", "momentum_y", "momentum_z"};
+  if (out.hourglassContent) energyColumns.push_back("hourglass_content");
+  CsvSeries energies(dir / "energies.csv", energyColumns);
   energies.setPreamble(preamble);
   std::unique_ptr<CsvSeries> probes;
   if (!setup.probes.empty()) {
@@ -146,9 +148,20 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
     const EnergyBalance e = solver.energyBalance();
     Vec3 momentum = Vec3::Zero();
     momentum.head<D>() = linearMomentum(p);
-    energies.append({solver.time(), double(solver.stepCount()), e.kinetic, e.strain, e.hourglass,
-                     e.externalWork, e.boundaryWork, e.damped, e.total(), solver.residualRatio(),
-                     momentum.x(), momentum.y(), momentum.z()});
+    std::vector<double> row = {solver.time(),  double(solver.stepCount()),
+                               e.kinetic,      e.strain,
+                               e.hourglass,    e.externalWork,
+                               e.boundaryWork, e.damped,
+                               e.total(),      solver.residualRatio(),
+                               momentum.x(),   momentum.y(),
+                               momentum.z()};
+    if (out.hourglassContent) {
+      std::vector<Mat<D>> H = solver.forces().deformationGradient();
+      for (auto& h : H)
+        h -= Mat<D>::Identity();
+      row.push_back(hourglassContent(solver.reference(), p.volume, p.displacement, H));
+    }
+    energies.append(row);
     if (probes) probes->append(probeRow(setup, solver));
     if (reactions) reactions->append(reactionRow());
   };

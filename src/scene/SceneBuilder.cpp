@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <map>
 #include <numbers>
+#include <random>
 #include <set>
 #include <stdexcept>
 
@@ -573,8 +574,20 @@ class Builder {
       SectionReader r(config_, "initial." + name);
       const auto& particles = region(r);
       const std::string profile =
-          r.word("profile", "constant", {"constant", "beam-mode", "rotation"});
-      if (profile == "constant") {
+          r.word("profile", "constant", {"constant", "beam-mode", "rotation", "random"});
+      if (profile == "random") {
+        // Each component uniform in [-amplitude, amplitude], from a seeded generator: a
+        // reproducible excitation of every mode, the spurious ones included.
+        const double amplitude = r.positive("amplitude");
+        const long seed = r.integer("seed", 1);
+        std::mt19937_64 rng(static_cast<std::uint64_t>(seed));
+        std::uniform_real_distribution<double> unit(-1.0, 1.0);
+        for (Index i : particles)
+          for (int a = 0; a < D; ++a)
+            p.velocity[i][a] = amplitude * unit(rng);
+        setup_.conditions.push_back("initial." + name + ": random velocity, components up to " +
+                                    fmt(amplitude) + " m/s, seed " + std::to_string(seed));
+      } else if (profile == "constant") {
         const Vec<D> v = r.vector<D>("velocity");
         for (Index i : particles)
           p.velocity[i] = v;
@@ -621,7 +634,7 @@ class Builder {
                                     " m/s");
       }
       r.allow({"velocity", "amplitude", "amplitude_over_c0", "axis", "direction", "origin",
-               "length", "kL", "point", "rate"});
+               "length", "kL", "point", "rate", "seed"});
       r.finish();
     }
   }
@@ -696,6 +709,7 @@ class Builder {
     if (setup_.output.everySteps == 0 && setup_.output.everyTime == 0.0)
       setup_.output.everyTime = setup_.run.endTime / 20.0;
     setup_.output.seriesEverySteps = std::max(1L, o.integer("series_every_steps", 20));
+    setup_.output.hourglassContent = o.flag("hourglass_content", false);
     o.finish();
   }
 

@@ -32,6 +32,7 @@ struct OutputSettings {
   long everySteps = 0;              // VTU frame every N steps (0: use everyTime)
   double everyTime = 0.0;           // VTU frame every T seconds of simulated time
   long seriesEverySteps = 0;        // energies/probes CSV row every N steps
+  bool hourglassContent = false;    // energies.csv: the displacement field's hourglass content
 };
 
 // The run's stability guards ([guard]), evaluated every RunSettings::checkEvery steps.

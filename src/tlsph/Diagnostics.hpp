@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "tlsph/Particles.hpp"
+#include "tlsph/ReferenceConfiguration.hpp"
 #include "tlsph/Types.hpp"
 
 namespace tlsph {
@@ -20,6 +21,29 @@ double kineticEnergy(const ParticleSet<D>& p) {
   for (Index i = 0; i < n; ++i)
     if (p.motion[i] == Motion::Free) sum += 0.5 * p.mass[i] * p.velocity[i].squaredNorm();
   return sum;
+}
+
+// Hourglass content of a displacement field u with displacement gradients H (H = F - 1):
+//   sum_IJ W_IJ V_J |e_IJ|^2 / sum_IJ W_IJ V_J |u_I - u_J|^2,  e_IJ = u_I - u_J - 1/2 (H_I + H_J)
+//   X_IJ,
+// the share of the neighbours' relative displacement that the smooth field does not explain:
+// 0 for affine fields (with the quadratic correction, quadratic ones), near 1 for a zig-zag.
+template <int D>
+double hourglassContent(const ReferenceConfiguration<D>& ref, const std::vector<double>& volume,
+                        const std::vector<Vec<D>>& u, const std::vector<Mat<D>>& H) {
+  const auto& nb = ref.neighbours;
+  const Index n = ref.particleCount();
+  double error = 0.0, total = 0.0;
+#pragma omp parallel for reduction(+ : error, total) schedule(static)
+  for (Index i = 0; i < n; ++i)
+    for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
+      const Index j = nb.neighbour[k];
+      const double w = ref.kernelValue[k] * volume[j];
+      const Vec<D> d = u[i] - u[j];
+      error += w * (d - 0.5 * (H[i] + H[j]) * ref.separation[k]).squaredNorm();
+      total += w * d.squaredNorm();
+    }
+  return total > 0.0 ? error / total : 0.0;
 }
 
 template <int D>

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "tlsph/ConjugateGradients.hpp"
+#include "tlsph/Diagnostics.hpp"
 #include "tlsph/DofMap.hpp"
 #include "tlsph/SparseCholesky.hpp"
 #include "tlsph/TangentStiffness.hpp"
@@ -60,26 +61,16 @@ std::vector<Index> mirrored(const std::vector<MirrorGhost>& ghosts) {
   return g;
 }
 
-// The hourglass content of the displacement field u (see Mode).
+// The hourglass content (Diagnostics.hpp) of the displacement field u.
 template <int D>
-double hourglassContent(const ReferenceConfiguration<D>& ref, const std::vector<double>& volume,
-                        const std::vector<Vec<D>>& u) {
+double hourglassContentOf(const ReferenceConfiguration<D>& ref, const std::vector<double>& volume,
+                          const std::vector<Vec<D>>& u) {
   const auto& nb = ref.neighbours;
-  const Index n = ref.particleCount();
-  std::vector<Mat<D>> H(n, Mat<D>::Zero());
-  for (Index i = 0; i < n; ++i)
+  std::vector<Mat<D>> H(ref.particleCount(), Mat<D>::Zero());
+  for (Index i = 0; i < ref.particleCount(); ++i)
     for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k)
       H[i] += (u[nb.neighbour[k]] - u[i]) * ref.correctedGradient[k].transpose();
-  double error = 0.0, total = 0.0;
-  for (Index i = 0; i < n; ++i)
-    for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
-      const Index j = nb.neighbour[k];
-      const double w = ref.kernelValue[k] * volume[j];
-      const Vec<D> d = u[i] - u[j];
-      error += w * (d - 0.5 * (H[i] + H[j]) * ref.separation[k]).squaredNorm();
-      total += w * d.squaredNorm();
-    }
-  return total > 0.0 ? error / total : 0.0;
+  return hourglassContent(ref, volume, u, H);
 }
 
 }  // namespace
@@ -171,7 +162,7 @@ ModalResult<D> computeModes(const Scene<D>& scene, Solver<D>& solver,
     const double energy = phi.dot(Kphi);
     mode.penaltyShare = energy > 0.0 && !mode.zero ? phi.dot(Khg) / energy : 0.0;
     dofs.expand(phi, full);
-    mode.hourglassContent = hourglassContent(solver.reference(), p.volume, full);
+    mode.hourglassContent = hourglassContentOf(solver.reference(), p.volume, full);
     double largest = 0.0;
     for (const auto& u : full)
       largest = std::max(largest, u.norm());
