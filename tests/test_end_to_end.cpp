@@ -8,11 +8,16 @@
 #include <vtkUnstructuredGrid.h>
 #include <vtkXMLUnstructuredGridReader.h>
 
+#include <signal.h>
+
+#include <algorithm>
+#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <regex>
+#include <thread>
 
 #include <sstream>
 #include <string>
@@ -136,4 +141,36 @@ TEST_F(EndToEnd, CheckPrintsTheSetUpWithoutRunning) {
   for (const char* part : {"particles", "neighbours", "dt =", "wave speed", "prescribe.root"})
     EXPECT_NE(r.output.find(part), std::string::npos) << part << "\n" << r.output;
   EXPECT_FALSE(fs::exists(dir_ / "out"));
+}
+
+// A run killed (SIGKILL, no chance to clean up) leaves its CSV series up to the last flush:
+// [output] flush_every_seconds bounds how much wall time of series it can lose.
+TEST_F(EndToEnd, KilledRunLeavesItsSeries) {
+  // No frame before the end (every_time = end): only the wall-time flush writes the series.
+  const std::string flush = "0.2";
+  const fs::path out = dir_ / "out";
+  const std::string command = std::string(TLSPH_PROGRAM) + " run " + TLSPH_SOURCE_DIR +
+                              "/examples/hourglass_block.ini --time.end=1000 --output.fields=none "
+                              "--output.every_time=1000 --output.flush_every_seconds=" +
+                              flush + " --output.directory=" + out.string() + " > " +
+                              (dir_ / "log.txt").string() + " 2>&1 & echo $! > " +
+                              (dir_ / "pid").string();
+  ASSERT_EQ(std::system(command.c_str()), 0);
+  std::this_thread::sleep_for(std::chrono::seconds(3));
+  std::ifstream pidFile(dir_ / "pid");
+  long pid = 0;
+  pidFile >> pid;
+  ASSERT_GT(pid, 0);
+  ASSERT_EQ(::kill(static_cast<pid_t>(pid), SIGKILL), 0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  std::ifstream csv(out / "energies.csv");
+  ASSERT_TRUE(csv.good());
+  std::string line;
+  int rows = 0;
+  while (std::getline(csv, line))
+    if (!line.empty() && line[0] != '#') {
+      EXPECT_EQ(std::count(line.begin(), line.end(), ','), 13) << line;  // 14 columns
+      ++rows;
+    }
+  EXPECT_GT(rows, 10);  // the header and rows written while it ran
 }

@@ -228,6 +228,10 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
   }
   double nextFrameTime = out.everyTime;
   auto lastProgress = Clock::now();
+  // The CSV series reach the disk at least every flushSeconds of wall time, so a run that is
+  // killed leaves its series up to then (frames flush them too).
+  auto lastFlush = Clock::now();
+  const auto flushInterval = std::chrono::duration<double>(out.flushSeconds);
   const double endTime = run.endTime * (1.0 - 1e-12);
   while (true) {
     if (solver.time() >= endTime) {
@@ -254,7 +258,15 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
         break;
       }
     }
-    if (step % out.seriesEverySteps == 0) recordSeries();
+    if (step % out.seriesEverySteps == 0) {
+      recordSeries();
+      if (Clock::now() - lastFlush > flushInterval) {
+        energies.flush();
+        if (probes) probes->flush();
+        if (reactions) reactions->flush();
+        lastFlush = Clock::now();
+      }
+    }
     const bool frameDue = out.everySteps > 0 ? step % out.everySteps == 0
                                              : solver.time() >= nextFrameTime * (1.0 - 1e-12);
     if (frameDue) {

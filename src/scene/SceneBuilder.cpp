@@ -710,6 +710,7 @@ class Builder {
       setup_.output.everyTime = setup_.run.endTime / 20.0;
     setup_.output.seriesEverySteps = std::max(1L, o.integer("series_every_steps", 20));
     setup_.output.hourglassContent = o.flag("hourglass_content", false);
+    setup_.output.flushSeconds = o.nonNegative("flush_every_seconds", 10.0);
     o.finish();
   }
 

@@ -33,6 +33,7 @@ struct OutputSettings {
   double everyTime = 0.0;           // VTU frame every T seconds of simulated time
   long seriesEverySteps = 0;        // energies/probes CSV row every N steps
   bool hourglassContent = false;    // energies.csv: the displacement field's hourglass content
+  double flushSeconds = 10.0;       // CSV series written at least this often [s of wall time]
 };
 
 // The run's stability guards ([guard]), evaluated every RunSettings::checkEvery steps.
