@@ -33,6 +33,10 @@ fi
 if [ "$action" = validate ]; then
   packages+=(calculix-ccx)
 fi
+# The scene-parser fuzzer is built with clang's libFuzzer.
+if [ "$action" = fuzz ]; then
+  packages+=(clang libclang-rt-14-dev)
+fi
 
 missing=()
 for pkg in "${packages[@]}"; do
@@ -46,6 +50,32 @@ if ((${#missing[@]})); then
   if [ "$(id -u)" -ne 0 ]; then sudo_cmd=(sudo); fi
   "${sudo_cmd[@]}" apt-get update -qq
   DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq "${missing[@]}" >/dev/null
+fi
+
+if [ "$action" = sanitize ]; then
+  # The fast test suite (without the validation label) built with AddressSanitizer and
+  # UndefinedBehaviorSanitizer, in its own build directory.
+  build_dir="${BUILD_DIR:-build-sanitize}"
+  cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTLSPH_SANITIZE=ON >/dev/null
+  cmake --build "$build_dir" -j "$jobs"
+  ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
+    ctest --test-dir "$build_dir" --output-on-failure -j "$jobs" -LE validation
+  exit 0
+fi
+if [ "$action" = fuzz ]; then
+  # The scene parser under libFuzzer for FUZZ_SECONDS (default 60) from the example and
+  # validation scenes; a crashing input is written to fuzz-findings/ (make it a regression
+  # test in tests/fuzz-regressions/).
+  build_dir="${BUILD_DIR:-build-fuzz}"
+  cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
+    -DTLSPH_FUZZ=ON -DTLSPH_OPENMP=OFF -DTLSPH_BUILD_TESTS=OFF >/dev/null
+  cmake --build "$build_dir" -j "$jobs" --target tlsph_fuzz_scene
+  corpus="$build_dir/fuzz-corpus"
+  mkdir -p "$corpus" fuzz-findings
+  cp examples/*.ini validation/scenes/*.ini tests/fuzz-regressions/*.ini "$corpus"/ 2>/dev/null || true
+  "$build_dir/tlsph_fuzz_scene" "$corpus" -max_total_time="${FUZZ_SECONDS:-60}" -timeout=10 \
+    -rss_limit_mb=2048 -artifact_prefix=fuzz-findings/ -print_final_stats=1
+  exit 0
 fi
 
 cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release >/dev/null
@@ -75,7 +105,7 @@ case "$action" in
     /usr/bin/python3 validation/stability.py --build-dir "$build_dir" "$@"
     ;;
   *)
-    echo "usage: scripts/setup.sh [build|test|example|validate|stability]" >&2
+    echo "usage: scripts/setup.sh [build|test|example|validate|stability|sanitize|fuzz]" >&2
     exit 2
     ;;
 esac
