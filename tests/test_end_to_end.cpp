@@ -174,3 +174,37 @@ TEST_F(EndToEnd, KilledRunLeavesItsSeries) {
     }
   EXPECT_GT(rows, 10);  // the header and rows written while it ran
 }
+
+// SIGTERM (and SIGINT) stop a run at the end of its step: it writes its series, a frame and
+// summary.json (outcome "interrupted") and exits with 128 + 15.
+TEST_F(EndToEnd, TerminatedRunWritesItsOutputAndExits143) {
+  const fs::path out = dir_ / "out";
+  const std::string command = "sh -c '" + std::string(TLSPH_PROGRAM) + " run " +
+                              TLSPH_SOURCE_DIR +
+                              "/examples/hourglass_block.ini --time.end=1000 "
+                              "--output.every_time=1000 --output.directory=" +
+                              out.string() + " > " + (dir_ / "log.txt").string() +
+                              " 2>&1 & pid=$!; sleep 2; kill -TERM $pid; wait $pid; echo $? > " +
+                              (dir_ / "status").string() + "'";
+  ASSERT_EQ(std::system(command.c_str()), 0);
+  std::ifstream statusFile(dir_ / "status");
+  int status = -1;
+  statusFile >> status;
+  std::ifstream logFile(dir_ / "log.txt");
+  std::stringstream log;
+  log << logFile.rdbuf();
+  EXPECT_EQ(status, 143) << log.str();
+  EXPECT_NE(log.str().find("stopped by signal 15 at step"), std::string::npos) << log.str();
+  std::ifstream recordFile(out / "summary.json");
+  std::stringstream record;
+  record << recordFile.rdbuf();
+  EXPECT_NE(record.str().find("\"outcome\": \"interrupted\""), std::string::npos) << record.str();
+  // the initial frame and the frame of the state it stopped in
+  EXPECT_TRUE(fs::exists(out / "hourglass_block_000001.vtu"));
+  int rows = 0;
+  std::ifstream csv(out / "energies.csv");
+  std::string line;
+  while (std::getline(csv, line))
+    rows += !line.empty() && line[0] != '#';
+  EXPECT_GT(rows, 10);
+}

@@ -43,6 +43,8 @@ inline const char* outcomeName(RunOutcome o) {
       return "not-converged";
     case RunOutcome::Unstable:
       return "unstable";
+    case RunOutcome::Interrupted:
+      return "interrupted";
   }
   return "";
 }

@@ -14,6 +14,7 @@
 
 #include "app/Frames.hpp"
 #include "app/Guards.hpp"
+#include "app/StopRequest.hpp"
 #include "output/CsvSeries.hpp"
 #include "output/VtuSeriesWriter.hpp"
 #include "scene/SceneSetup.hpp"
@@ -27,7 +28,7 @@ struct RunOptions {
   std::string command;    // recorded in the CSV preamble, to reproduce the run
 };
 
-enum class RunOutcome { Finished, Converged, NotConverged, Unstable };
+enum class RunOutcome { Finished, Converged, NotConverged, Unstable, Interrupted };
 
 struct RunSummary {
   RunOutcome outcome = RunOutcome::Finished;
@@ -194,6 +195,12 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
     }
     return summary;
   };
+  auto interruptedMessage = [&] {
+    std::ostringstream m;
+    m << "stopped by signal " << int(stopSignal()) << " at step " << solver.stepCount()
+      << ", t = " << solver.time() << " s: the output holds the state at that step";
+    return m.str();
+  };
   if (run.newtonStatic()) {
     // Load steps to equilibrium: one series row and one frame per converged step.
     NewtonSolver<D> newton(setup.scene, solver, run.newton);
@@ -201,6 +208,7 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
       newton.run([&] {
         recordSeries();
         writeFrame();
+        if (stopRequested()) return false;
         if (options.progress) {
           const auto& st = newton.statistics();
           std::fprintf(stderr,
@@ -210,8 +218,10 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
                        solver.residualRatio(), run.tolerance);
           std::fflush(stderr);
         }
+        return true;
       });
-      summary.outcome = RunOutcome::Converged;
+      summary.outcome = stopRequested() ? RunOutcome::Interrupted : RunOutcome::Converged;
+      if (stopRequested()) summary.message = interruptedMessage();
     } catch (const NewtonFailure& failure) {
       summary.outcome = RunOutcome::NotConverged;
       summary.message = failure.what();
@@ -242,6 +252,11 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
       summary.outcome = run.quasiStatic ? RunOutcome::NotConverged : RunOutcome::Finished;
       summary.message =
           "stopped at the step limit [time] max_steps = " + std::to_string(run.maxSteps);
+      break;
+    }
+    if (stopRequested()) {
+      summary.outcome = RunOutcome::Interrupted;
+      summary.message = interruptedMessage();
       break;
     }
     solver.step();

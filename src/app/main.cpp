@@ -50,7 +50,9 @@ run options:
 exit status: 0 finished (or a static run converged), 1 bad input or set-up, 3 a static
 run did not converge, 4 the run went unstable (a [guard] check failed: the message names
 step, particle, quantity and likely cause; NAME_last_good.vtu and NAME_failed.vtu are
-written), 5 (modes) zero-energy modes other than rigid-body motions.
+written), 5 (modes) zero-energy modes other than rigid-body motions, 130 / 143 stopped by
+SIGINT (Ctrl-C) / SIGTERM: the series, a frame and summary.json hold the state at the step it
+stopped (a second signal ends the program at once).
 )";
 
 using namespace tlsph;
@@ -176,6 +178,7 @@ int runOrCheck(const Config& config, bool run, bool progress, const std::string&
   RunOptions options;
   options.progress = progress;
   options.command = command;
+  installStopHandlers();
   NeighbourStats neighbours;
   const RunSummary s = runSimulation(setup, options, [&](const Solver<D>& solver) {
     addSolverWarnings(setup, solver, command);
@@ -233,6 +236,9 @@ int runOrCheck(const Config& config, bool run, bool progress, const std::string&
       std::cout << "NOT converged: residual " << s.residual << " >= " << setup.run.tolerance
                 << " at the end time; raise [time] end or the damping\n";
       return 3;
+    case RunOutcome::Interrupted:
+      std::cout << "interrupted\n";
+      return 128 + int(stopSignal());
     case RunOutcome::Unstable: {
       // tlsph: unstable at step N, t = T s: <quantity and value> at particle I (X = ...):
       //   likely <cause>

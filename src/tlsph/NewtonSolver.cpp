@@ -20,7 +20,7 @@ NewtonSolver<D>::NewtonSolver(Scene<D>& scene, Solver<D>& solver, const NewtonSe
 }
 
 template <int D>
-void NewtonSolver<D>::run(const std::function<void()>& onStep) {
+void NewtonSolver<D>::run(const std::function<bool()>& onStep) {
   const double end = solver_.rampEnd();
   double done = 0.0;
   double increment = end > 0.0 ? end / settings_.loadSteps : 0.0;
@@ -34,7 +34,7 @@ void NewtonSolver<D>::run(const std::function<void()>& onStep) {
       ++statistics_.loadSteps;
       done = target;
       first = false;
-      onStep();
+      if (!onStep()) return;
       continue;
     }
     solver_.abandonStaticStep();  // back to the last converged state

@@ -60,9 +60,9 @@ class NewtonSolver {
   const DofMap<D>& dofs() const { return dofs_; }
   TangentStiffness<D>& tangent() { return tangent_; }
 
-  // Solves the load steps up to the end of the ramps; onStep() after each converged one.
-  // Throws NewtonFailure with the scene at the last converged state.
-  void run(const std::function<void()>& onStep);
+  // Solves the load steps up to the end of the ramps; onStep() after each converged one, which
+  // returns false to stop there. Throws NewtonFailure with the scene at the last converged state.
+  void run(const std::function<bool()>& onStep);
 
  private:
   static std::vector<Index> mirroredParticles(const Scene<D>& scene);
