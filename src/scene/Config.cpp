@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <boost/program_options.hpp>
 #include <cctype>
+#include <cerrno>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 
@@ -30,6 +32,21 @@ std::pair<std::string, std::string> splitKey(const std::string& dotted) {
   return {kind, dotted.substr(first + 1)};
 }
 
+// A line quoted in a message: control and non-ASCII bytes (a binary file) as \xNN, cut short.
+std::string printable(const std::string& line) {
+  std::string out;
+  for (const char c : line.substr(0, 60)) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u >= 0x20 && u < 0x7f) {
+      out += c;
+    } else {
+      static const char* hex = "0123456789abcdef";
+      out += std::string("\\x") + hex[u >> 4] + hex[u & 15];
+    }
+  }
+  return line.size() > 60 ? out + "..." : out;
+}
+
 std::string trim(const std::string& s) {
   const auto b = s.find_first_not_of(" \t\r\n");
   if (b == std::string::npos) return "";
@@ -40,10 +57,20 @@ std::string trim(const std::string& s) {
 }  // namespace
 
 Config Config::read(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
+  std::error_code status;
+  if (!std::filesystem::exists(file, status))
+    throw InputError(file.string(), "", "", "cannot open the scene file: no such file");
+  if (std::filesystem::is_directory(file, status))
+    throw InputError(file.string(), "", "", "is a directory, not a scene file");
   std::ifstream in(file);
-  if (!in) throw InputError(file.string(), "", "", "cannot open the scene file");
+  if (!in)
+    throw InputError(file.string(), "", "",
+                     "cannot open the scene file: " + std::string(std::strerror(errno)));
   std::stringstream text;
   text << in.rdbuf();
+  if (in.bad())
+    throw InputError(file.string(), "", "",
+                     "cannot read the scene file: " + std::string(std::strerror(errno)));
   return parse(text.str(), file.string(), overrides);
 }
 
@@ -53,20 +80,39 @@ Config Config::parse(const std::string& text, const std::string& origin,
   config.origin_ = origin;
   // Boost reports keys but neither empty sections ([static] alone switches a static run on)
   // nor line numbers: one pass over the lines records both.
+  // The same pass rejects what Boost would report without a line (a line that is neither a
+  // header nor a key) or accept silently (a key given twice: the last would win).
   std::map<std::string, int> lineOf;
   {
     std::istringstream in(text);
     std::string line, section;
+    bool sections = false;
     for (int number = 1; std::getline(in, line); ++number) {
       line = trim(line.substr(0, line.find('#')));
+      const std::string here = origin + ":" + std::to_string(number);
+      if (line.empty()) continue;
       if (line.size() >= 2 && line.front() == '[' && line.back() == ']') {
+        // A header may appear again (its keys are merged), but not a key.
         section = trim(line.substr(1, line.size() - 2));
-        config.addSection(section, origin + ":" + std::to_string(number));
+        if (section.empty()) throw InputError(here, "", "", "empty section name '[]'");
+        sections = true;
+        config.addSection(section, here);
       } else if (const auto eq = line.find('='); eq != std::string::npos) {
         const std::string key = trim(line.substr(0, eq));
-        lineOf[section.empty() ? key : section + "." + key] = number;
+        if (key.empty()) throw InputError(here, section, "", "a key is missing before '='");
+        const std::string dotted = section.empty() ? key : section + "." + key;
+        if (const auto first = lineOf.find(dotted); first != lineOf.end())
+          throw InputError(here, section, key,
+                           "key given twice (first at line " + std::to_string(first->second) +
+                               "); remove one of them");
+        lineOf[dotted] = number;
+      } else {
+        throw InputError(here, section, "",
+                         "expected '[section]' or 'key = value', got '" + printable(line) + "'");
       }
     }
+    if (!sections && lineOf.empty())
+      throw InputError(origin, "", "", "the scene file is empty (no [section] and no key)");
   }
   po::options_description none;
   try {
@@ -88,7 +134,7 @@ Config Config::parse(const std::string& text, const std::string& origin,
     if (eq == std::string::npos || eq == 0)
       throw InputError("command line", "", o, "an override must look like --section.key=value");
     const std::string key = trim(o.substr(0, eq));
-    if (splitKey(key).first.empty())
+    if (splitKey(key).first.empty() || splitKey(key).second.empty())
       throw InputError("command line", "", key,
                        "an override must name a section and a key, e.g. --time.end=0.5");
     config.set(key, trim(o.substr(eq + 1)), "command line");

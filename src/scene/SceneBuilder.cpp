@@ -139,8 +139,13 @@ class Builder {
     r.allow({"dimension"});
     setup_.sourceFile = config_.origin();
     setup_.name = r.word("name", std::filesystem::path(config_.origin()).stem().string());
+    if (setup_.name.empty() || setup_.name.find_first_of("/\\") != std::string::npos)
+      throw r.error("name", "must be a file name without '/' (it names the output files), got '" +
+                                setup_.name + "'");
     setup_.dx = r.positive("dx");
-    maxParticles_ = static_cast<std::size_t>(r.positive("max_particles", 5e6));
+    const long most = r.integer("max_particles", 5'000'000);
+    if (most < 1) throw r.error("max_particles", "must be at least 1, got " + fmt(double(most)));
+    maxParticles_ = static_cast<std::size_t>(most);
     r.finish();
   }
 
@@ -157,21 +162,36 @@ class Builder {
       const std::string model = r.word("model", std::nullopt, models);
       const double density = r.positive("density");
       ElasticConstants c;
-      try {
-        if (r.has("youngs_modulus") || r.has("poisson_ratio")) {
-          c = ElasticConstants::fromYoungPoisson(r.number("youngs_modulus"),
-                                                 r.number("poisson_ratio"));
-        } else if (r.has("lame_lambda")) {
-          c = ElasticConstants::fromLame(r.number("lame_lambda"), r.number("shear_modulus"));
-        } else if (r.has("shear_modulus") && r.has("bulk_modulus")) {
-          c = ElasticConstants::fromShearBulk(r.number("shear_modulus"), r.number("bulk_modulus"));
-        } else {
-          throw r.error("",
-                        "give the elastic constants as youngs_modulus + poisson_ratio, "
-                        "lame_lambda + shear_modulus, or shear_modulus + bulk_modulus");
+      // One pair of constants. A constant out of its range is reported at its own key: the
+      // first of each pair is a modulus that must be positive, else the second is to blame.
+      auto pair = [&](const std::string& first, const std::string& second, auto make) {
+        const double a = r.number(first), b = r.number(second);
+        try {
+          return make(a, b);
+        } catch (const MaterialError& e) {
+          throw r.error(a > 0.0 ? second : first, e.what());
         }
+      };
+      if (r.has("youngs_modulus") || r.has("poisson_ratio")) {
+        c = pair("youngs_modulus", "poisson_ratio", ElasticConstants::fromYoungPoisson);
+      } else if (r.has("lame_lambda")) {
+        c = pair("shear_modulus", "lame_lambda",
+                 [](double mu, double lambda) { return ElasticConstants::fromLame(lambda, mu); });
+      } else if (r.has("shear_modulus") && r.has("bulk_modulus")) {
+        c = pair("shear_modulus", "bulk_modulus", ElasticConstants::fromShearBulk);
+      } else {
+        throw r.error("",
+                      "give the elastic constants as youngs_modulus + poisson_ratio, "
+                      "lame_lambda + shear_modulus, or shear_modulus + bulk_modulus");
+      }
+      try {
         if (model == "mooney-rivlin") {
-          setup_.scene.materials.push_back(MooneyRivlin(c, density, r.number("c01_fraction", 0.5)));
+          const double fraction = r.number("c01_fraction", 0.5);
+          try {
+            setup_.scene.materials.push_back(MooneyRivlin(c, density, fraction));
+          } catch (const MaterialError& e) {
+            throw r.error("c01_fraction", e.what());
+          }
         } else {
           setup_.scene.materials.push_back(makeMaterial(model, c, density));
         }
@@ -225,8 +245,12 @@ class Builder {
       shapes.push_back(readShape<D>(r, false));
       materialOfBody.push_back(materialIndex(r));
       r.finish();
+      checkLatticeRange(r, shapes.back());
       setup_.bodyNames.push_back(name);
     }
+    if (names.size() > 256)  // the output's `body` flag is one byte
+      throw InputError(config_.where("body." + names[256], ""), "body." + names[256], "",
+                       "a scene holds at most 256 bodies");
     std::vector<Shape<D>> holes;
     for (const auto& name : config_.namesOf("hole")) {
       SectionReader r(config_, "hole." + name);
@@ -236,21 +260,34 @@ class Builder {
     std::vector<Vec<D>> points;
     try {
       points = fillLattice<D>(shapes, setup_.dx, Vec<D>::Zero(), maxParticles_);
-      // [hole.NAME]: the lattice points inside a hole belong to no body.
-      std::erase_if(points, [&](const Vec<D>& X) {
-        return std::any_of(holes.begin(), holes.end(),
-                           [&](const Shape<D>& h) { return contains(h, X); });
-      });
     } catch (const std::length_error& e) {
+      // The geometry's message, in the scene's words.
+      std::string what = e.what();
+      if (what.rfind("fillLattice: ", 0) == 0) what = what.substr(13);
+      if (const auto at = what.find("(maxPoints)"); at != std::string::npos)
+        what.replace(at, 11, "([scene] max_particles)");
       throw InputError(config_.where("scene", "dx"), "scene", "dx",
-                       std::string(e.what()) +
-                           " (raise [scene] max_particles if the machine has the memory: "
-                           "about 2 kB per particle in 3D)");
+                       what +
+                           "; raise [scene] max_particles if the machine has the memory "
+                           "(about 2 kB per particle in 3D)");
+    } catch (const std::invalid_argument& e) {
+      throw InputError(config_.where("scene", "dx"), "scene", "dx", e.what());
     }
     if (points.empty())
-      throw InputError(config_.origin(), "body." + names[0], "",
+      throw InputError(config_.where("body." + names[0], "shape"), "body." + names[0], "shape",
                        "the bodies contain no lattice point at dx = " + fmt(setup_.dx) +
-                           "; make them larger than dx");
+                           " (particles sit at cell centres (n + 1/2) dx); make them larger "
+                           "than dx");
+    // [hole.NAME]: the lattice points inside a hole belong to no body.
+    std::erase_if(points, [&](const Vec<D>& X) {
+      return std::any_of(holes.begin(), holes.end(),
+                         [&](const Shape<D>& h) { return contains(h, X); });
+    });
+    if (points.empty()) {
+      const std::string hole = "hole." + config_.namesOf("hole").front();
+      throw InputError(config_.where(hole, "shape"), hole, "shape",
+                       "the holes remove every particle of the bodies");
+    }
     const double V = std::pow(setup_.dx, D);
     auto& p = setup_.scene.particles;
     for (const auto& X : points) {
@@ -263,10 +300,42 @@ class Builder {
       setup_.ghost.push_back(0);
     }
     bodyCount_ = p.size();
+    // A body that holds no particle is a mistake (a shape smaller than dx, or one inside an
+    // earlier body or a hole): it would silently be left out.
+    std::vector<Index> perBody(names.size(), 0);
+    for (const auto b : setup_.body)
+      ++perBody[b];
+    for (std::size_t b = 0; b < names.size(); ++b) {
+      if (perBody[b] > 0) continue;
+      const bool anyPoint =
+          !fillLattice<D>({shapes[b]}, setup_.dx, Vec<D>::Zero(), maxParticles_).empty();
+      throw InputError(config_.where("body." + names[b], "shape"), "body." + names[b], "shape",
+                       anyPoint
+                           ? "the body holds no particle: each of its lattice points at dx = " +
+                                 fmt(setup_.dx) + " lies in an earlier body or in a hole"
+                           : "the body holds no lattice point at dx = " + fmt(setup_.dx) +
+                                 " (particles sit at cell centres (n + 1/2) dx); make it "
+                                 "larger than dx or move it onto the lattice");
+    }
     std::vector<Index> all(bodyCount_);
     for (Index i = 0; i < bodyCount_; ++i)
       all[i] = i;
     setup_.regions["all"] = all;
+  }
+
+  // The lattice indices of a body's bounding box must fit in a double's integers: a coordinate
+  // mistyped by orders of magnitude (or a dx far too small for it) is named here.
+  void checkLatticeRange(SectionReader& r, const Shape<D>& shape) {
+    const auto box = bounds(shape);
+    if (!box) return;
+    for (int a = 0; a < D; ++a)
+      if (!geometry_detail::indexSpan(box->min()[a], box->max()[a], 0.0, setup_.dx))
+        throw r.error("shape",
+                      std::string("the body reaches ") + "xyz"[a] + " = " +
+                          fmt(std::abs(box->min()[a]) > std::abs(box->max()[a]) ? box->min()[a]
+                                                                                : box->max()[a]) +
+                          ", too many lattice spacings (dx = " + fmt(setup_.dx) +
+                          ") from the origin");
   }
 
   std::uint16_t materialIndex(SectionReader& r) {
@@ -390,6 +459,21 @@ class Builder {
       clamp.name = "clamp." + name;
       const std::string motion = readMotion(r, clamp);
       r.finish();
+      // The ghosts count against [scene] max_particles too (a mistyped `layers`).
+      Index onFace = 0;
+      for (Index i = 0; i < bodyCount_; ++i)
+        onFace += onBoundingFace(i, face) ? 1 : 0;
+      const double total = double(p.size()) + double(onFace) * double(layers);
+      if (total > double(maxParticles_))
+        throw r.error(
+            "layers",
+            std::to_string(layers) + " ghost layers of the " + std::to_string(onFace) +
+                " particles on face " + face + " make " + fmt(total) +
+                " particles, more than [scene] max_particles = " + std::to_string(maxParticles_));
+      const std::string holds = method == "fixed"
+                                    ? "holds face " + face
+                                    : "mirrors the first " + std::to_string(layers) +
+                                          " body layers behind face " + face + " with its ghosts";
       const int axis = face[0] - 'x';
       const double sign = face[1] == '-' ? -1.0 : 1.0;
       const bool mirror = method != "fixed";
@@ -400,6 +484,7 @@ class Builder {
       Vec<D> thinAt = Vec<D>::Zero();
       for (Index i = 0; i < bodyCount_; ++i) {
         if (!onBoundingFace(i, face)) continue;
+        if (!mirror) clampHeld_.emplace(i, std::pair{name, holds});
         for (long k = 1; k <= layers; ++k) {
           Vec<D> G = X[i];
           G[axis] += sign * k * setup_.dx;
@@ -418,8 +503,10 @@ class Builder {
             };
             m.mirror = behind(k);
             mirrored = m.mirror >= 0;
+            if (mirrored) clampHeld_.emplace(m.mirror, std::pair{name, holds});
             if (mirrored && quadratic) {
               m.second = behind(k + 1);
+              if (m.second >= 0) clampHeld_.emplace(m.second, std::pair{name, holds});
               if (m.second >= 0) {
                 // Lagrange extrapolation through u_p on the face, body layers k and k + 1.
                 m.w1 = -2.0 * k;
@@ -506,6 +593,13 @@ class Builder {
       const std::string motion = readMotion(r, rule);
       r.finish();
       for (Index i : rule.particles) {
+        if (const auto c = clampHeld_.find(i); c != clampHeld_.end())
+          throw r.error("region", "particle " + std::to_string(i) + " at " +
+                                      fmt<D>(p.referencePosition[i]) + " is held by [clamp." +
+                                      c->second.first + "], which " + c->second.second +
+                                      ": a particle cannot be both clamped and prescribed; keep "
+                                      "the region clear of them, or move the face with the "
+                                      "clamp's own motion");
         if (p.motion[i] == Motion::Prescribed)
           throw r.error("region", "particle " + std::to_string(i) + " at " +
                                       fmt<D>(p.referencePosition[i]) +
@@ -653,14 +747,16 @@ class Builder {
         newton ? RunSettings::StaticSolver::Newton : RunSettings::StaticSolver::Damped;
     auto& n = setup_.run.newton;
     n.tolerance = setup_.run.tolerance;
-    n.loadSteps = static_cast<int>(s.integer("load_steps", 1));
-    if (n.loadSteps < 1 || n.loadSteps > 100000)
+    const long loadSteps = s.integer("load_steps", 1);
+    if (loadSteps < 1 || loadSteps > 100000)
       throw s.error("load_steps",
                     "must be between 1 and 100000, got " + config_.get("static", "load_steps"));
-    n.maxIterations = static_cast<int>(s.integer("max_iterations", 30));
-    if (n.maxIterations < 1)
+    n.loadSteps = static_cast<int>(loadSteps);
+    const long iterations = s.integer("max_iterations", 30);
+    if (iterations < 1 || iterations > 100000)
       throw s.error("max_iterations",
-                    "must be at least 1, got " + config_.get("static", "max_iterations"));
+                    "must be between 1 and 100000, got " + config_.get("static", "max_iterations"));
+    n.maxIterations = static_cast<int>(iterations);
     s.finish();
     SectionReader t(config_, "time");
     setup_.solver.cfl = t.positive("cfl", kDefaultCfl);
@@ -672,17 +768,17 @@ class Builder {
     t.finish();
     if (setup_.run.quasiStatic && newton && setup_.scene.hourglassCoefficient != 0.0 &&
         setup_.scene.hourglassForm != HourglassForm::Energy)
-      throw InputError(config_.origin(), "static", "solver",
+      throw InputError(config_.where("static", "solver"), "static", "solver",
                        "solver = newton needs the hourglass penalty's energy form ([hourglass] "
                        "form = energy): the textbook force (6.80)-(6.81) is not the gradient of "
                        "an energy and has no symmetric tangent");
     if (setup_.run.quasiStatic) {
       if (!newton && !setup_.scene.damping.any())
-        throw InputError(config_.origin(), "static", "enabled",
+        throw InputError(config_.where("static", "enabled"), "static", "enabled",
                          "a static run needs damping: set [damping] kinetic = true or viscous > 0, "
                          "or solve it with [static] solver = newton");
       if (setup_.scene.prescriptions.empty() && setup_.scene.mirrorGhosts.empty())
-        throw InputError(config_.origin(), "static", "enabled",
+        throw InputError(config_.where("static", "enabled"), "static", "enabled",
                          "a static run needs the body held: add a [clamp.NAME] or a "
                          "[prescribe.NAME] section, or it drifts away under its loads");
     }
@@ -691,6 +787,12 @@ class Builder {
   void readOutput() {
     SectionReader o(config_, "output");
     setup_.output.directory = o.word("directory", "output/" + setup_.name);
+    std::error_code status;
+    if (setup_.output.directory.empty())
+      throw o.error("directory", "must not be empty (give '.' for the working directory)");
+    if (std::filesystem::exists(setup_.output.directory, status) &&
+        !std::filesystem::is_directory(setup_.output.directory, status))
+      throw o.error("directory", "'" + setup_.output.directory + "' exists and is not a directory");
     setup_.output.fields = o.words("fields", {"displacement", "velocity", "von_mises", "flags"});
     if (setup_.output.fields.size() == 1 && setup_.output.fields[0] == "none")
       setup_.output.fields.clear();
@@ -784,7 +886,7 @@ class Builder {
       const std::string kind = section.substr(0, section.find('.'));
       if (std::find(kinds.begin(), kinds.end(), kind) != kinds.end()) continue;
       const std::string hint = closestMatch(kind, kinds);
-      throw InputError(config_.origin(), section, "",
+      throw InputError(config_.where(section, ""), section, "",
                        "unknown section" + (hint.empty() ? "" : "; did you mean [" + hint + "]?"));
     }
   }
@@ -796,6 +898,9 @@ class Builder {
   double supportRatio_ = 2.0;
   Index bodyCount_ = 0;
   std::map<std::array<long, D>, Index> latticeIndex_;  // lattice point -> body particle
+  // Body particles a clamp holds (its face layer, or the layers its ghosts mirror): the clamp's
+  // name and what it does, for the error when a [prescribe] region takes one of them too.
+  std::map<Index, std::pair<std::string, std::string>> clampHeld_;
 };
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <optional>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -69,12 +70,19 @@ class SectionReader {
       throw error(key, "must be zero or positive, got " + config_.get(section_, key));
     return v;
   }
-  long integer(const std::string& key, std::optional<long> fallback = std::nullopt) {
+  // A whole number in [0, most]; the default bound keeps every such number exact in a double.
+  long integer(const std::string& key, std::optional<long> fallback = std::nullopt,
+               long most = kLargestInteger) {
     const double v =
         number(key, fallback ? std::optional<double>(double(*fallback)) : std::nullopt);
-    if (v != std::floor(v) || v < 0) throw error(key, "must be a whole number >= 0");
+    if (v != std::floor(v) || v < 0)
+      throw error(key, "must be a whole number >= 0, got " + config_.get(section_, key));
+    if (v > double(most))
+      throw error(
+          key, "must be at most " + std::to_string(most) + ", got " + config_.get(section_, key));
     return static_cast<long>(v);
   }
+  static constexpr long kLargestInteger = 1L << 53;
   bool flag(const std::string& key, std::optional<bool> fallback = std::nullopt) {
     const std::string v = word(
         key, fallback ? std::optional<std::string>(*fallback ? "true" : "false") : std::nullopt);
@@ -161,8 +169,16 @@ class SectionReader {
     try {
       std::size_t used = 0;
       const double v = std::stod(text, &used);
-      if (used == text.size() && std::isfinite(v)) return v;
-    } catch (const std::exception&) {
+      if (used == text.size()) {
+        if (std::isfinite(v)) return v;
+        throw error(key, "expected a finite number, got '" + text + "'");
+      }
+    } catch (const std::out_of_range&) {
+      throw error(key,
+                  "expected a number within the range of a double (about 1e-308 to "
+                  "1e308 in magnitude, or 0), got '" +
+                      text + "'");
+    } catch (const std::invalid_argument&) {
     }
     throw error(key, "expected a number, got '" + text + "'");
   }
