@@ -179,8 +179,7 @@ TEST_F(EndToEnd, KilledRunLeavesItsSeries) {
 // summary.json (outcome "interrupted") and exits with 128 + 15.
 TEST_F(EndToEnd, TerminatedRunWritesItsOutputAndExits143) {
   const fs::path out = dir_ / "out";
-  const std::string command = "sh -c '" + std::string(TLSPH_PROGRAM) + " run " +
-                              TLSPH_SOURCE_DIR +
+  const std::string command = "sh -c '" + std::string(TLSPH_PROGRAM) + " run " + TLSPH_SOURCE_DIR +
                               "/examples/hourglass_block.ini --time.end=1000 "
                               "--output.every_time=1000 --output.directory=" +
                               out.string() + " > " + (dir_ / "log.txt").string() +

@@ -109,10 +109,18 @@ def richardson(hs, qs):
     return p, q3 - C * h3**p
 
 
-def ladder(runs, key, variant=None):
-    """Ladder runs of a problem, coarse to fine; variant None = all variants."""
+def is_newton(r):
+    """A static ladder run's Newton twin (`--static.solver=newton`, run.py)."""
+    return r.get("solver") == "newton"
+
+
+def ladder(runs, key, variant=None, solver="damped"):
+    """Ladder runs of a problem, coarse to fine; variant None = all variants. solver "damped"
+    (the default: every table but the solver comparison) or "newton" (the twins, skipped ones
+    included)."""
     out = [r for r in runs if r["problem"] == key and r["kind"] == "ladder" and
-           (variant is None or r["variant"] == variant)]
+           (variant is None or r["variant"] == variant) and
+           is_newton(r) == (solver == "newton")]
     return sorted(out, key=lambda r: -r["dx"])
 
 
@@ -141,7 +149,7 @@ def sensitivity(runs, key, param, p=None):
            r["param"] == param]
     if p is not None:
         for r in runs:
-            if (r["problem"] == key and r["kind"] == "ladder" and
+            if (r["problem"] == key and r["kind"] == "ladder" and not is_newton(r) and
                     abs(r["dx"] - p["sensitivity_dx"]) < 1e-12):
                 vs = variant_study(p, r["variant"])
                 if vs and vs[0] == param:
@@ -152,7 +160,7 @@ def sensitivity(runs, key, param, p=None):
 def mid_run(runs, key, dx, variant):
     for r in runs:
         if (r["problem"] == key and r["kind"] == "ladder" and abs(r["dx"] - dx) < 1e-12 and
-                r["variant"] == variant):
+                r["variant"] == variant and not is_newton(r)):
             return r
     return None
 
@@ -383,7 +391,8 @@ def with_static_comparison(runs):
     deflection against the static cantilever's tip with the same dx and the same overrides,
     in %, where that static run exists."""
     out = [dict(r) for r in runs]
-    static = [r for r in out if r["problem"] == "cantilever_static" and r.get("qoi")]
+    static = [r for r in out if r["problem"] == "cantilever_static" and r.get("qoi") and
+              not is_newton(r)]
     for r in out:
         if r["problem"] != "cantilever_dynamic" or val(r, "mean_deflection") is None:
             continue
@@ -405,6 +414,18 @@ def extra_error(r, name):
     else:
         e = ((r.get("qoi") or {}).get("errors") or {}).get(name)
     return None if e is None else e
+
+
+def newton_cell(runs, r):
+    """The summary's Newton column: the twin's wall time at the finest resolution."""
+    n = newton_twin(runs, r)
+    if n is None:
+        return "-"
+    if n.get("outcome") == "skipped":
+        return "not run (memory: %.0f GB predicted)" % (n.get("predicted_memory_gb") or 0)
+    if not converged(n):
+        return n.get("outcome") or str(n.get("rc"))
+    return "%.1f (%s)" % (n["wall_seconds"], x_text(speedup(r, n)))
 
 
 def readme(data, plots, plot_note):
@@ -453,15 +474,20 @@ def readme(data, plots, plot_note):
     L.append("| threads | OMP_NUM_THREADS=%s, OMP_WAIT_POLICY=%s |" % (
         m.get("threads", "?"), meta.get("omp_wait_policy") or "(default)"))
     reused = sum(1 for r in runs if r.get("reused"))
-    L.append("| runs | %d, started %s%s |" % (
-        len(runs), meta.get("started", "?"),
+    skipped = sum(1 for r in runs if r.get("outcome") == "skipped")
+    L.append("| runs | %d%s, started %s%s |" % (
+        len(runs) - skipped, " (and %d Newton twins skipped for their predicted memory, not "
+        "run)" % skipped if skipped else "", meta.get("started", "?"),
         "; %d of them reused from an earlier invocation of the same ladder (`--reuse`: same "
         "command, run after the scene file last changed; their wall times are those measured "
         "then)" % reused if reused else ""))
-    L.append("| wall time | %.0f s for all runs (%.1f min), of which the ladders %.0f s and "
-             "the sensitivity studies %.0f s |" % (
+    L.append("| wall time | %.0f s for all runs (%.1f min), of which the ladders %.0f s "
+             "(the static ladders' Newton twins %.0f s of them) and the sensitivity studies "
+             "%.0f s |" % (
                  total_wall, total_wall / 60.0,
                  sum(r.get("wall_runner") or 0 for r in runs if r["kind"] == "ladder"),
+                 sum(r.get("wall_runner") or 0 for r in runs if r["kind"] == "ladder" and
+                     is_newton(r)),
                  sum(r.get("wall_runner") or 0 for r in runs if r["kind"] == "sensitivity")))
     L.append("| command | `%s%s` |" % (
         "OMP_WAIT_POLICY=%s " % meta["omp_wait_policy"] if meta.get("omp_wait_policy") else "",
@@ -528,10 +554,10 @@ def readme(data, plots, plot_note):
                      err(fin, q.get("primary", "")) if q else outcome(fin),
                      extra or "-",
                      "%s %%" % tgt[1] if tgt else "-", met, o,
-                     "%.0f" % (fin.get("wall_seconds") or 0)])
+                     "%.0f" % (fin.get("wall_seconds") or 0), newton_cell(runs, fin)])
     L += table(["problem", "quantity (error)", "finest: per thickness / dx", "error %",
                 "other errors at the finest, %", "target", "met", "order (last pair)",
-                "wall s"], rows)
+                "wall s", "Newton wall s (static)"], rows)
     L.append("")
     L.append("Details, what limits each target, and the sensitivity studies follow. "
              "Order = observed order of the error against the reference between the two finest "
@@ -549,6 +575,8 @@ def readme(data, plots, plot_note):
         L.append("")
         L += notes.read_text().rstrip("\n").split("\n")
         L.append("")
+
+    L += solvers_section(P, runs, meta)
 
     # References
     L += references_section(R)
@@ -593,6 +621,310 @@ def readme(data, plots, plot_note):
         L.append("![%s](%s)" % (fname, fname))
         L.append("")
     return "\n".join(L) + "\n"
+
+
+# --------------------------------------------------------------------------------------------
+# Static problems: the damped dynamics against Newton (run.py's Newton twins)
+
+TIE = 1.1  # a speed-up within 10 % either way: a tie on the shared machine
+
+
+def newton_twin(runs, r):
+    """The Newton twin of a damped ladder run (same problem, variant and dx), or None."""
+    for x in runs:
+        if (is_newton(x) and x["kind"] == "ladder" and x["problem"] == r["problem"] and
+                x["variant"] == r["variant"] and abs(x["dx"] - r["dx"]) < 1e-12):
+            return x
+    return None
+
+
+def solver_pairs(runs, key, variant):
+    """[(damped run, its Newton twin or None)] of a ladder, coarse to fine."""
+    return [(r, newton_twin(runs, r)) for r in ladder(runs, key, variant)]
+
+
+def has_twins(runs, key):
+    return any(is_newton(r) and r["problem"] == key for r in runs)
+
+
+def converged(r):
+    return bool(r and r.get("outcome") == "converged" and r.get("wall_seconds"))
+
+
+def speedup(d, n):
+    """Damped wall time over Newton's (> 1: Newton faster), or None."""
+    if converged(d) and converged(n):
+        return d["wall_seconds"] / n["wall_seconds"]
+    return None
+
+
+def mem(mb):
+    if not mb:
+        return "-"
+    if mb < 10:
+        return "%.1f MB" % mb
+    return "%.0f MB" % mb if mb < 1000 else "%.2f GB" % (mb / 1024.0)
+
+
+def x_text(sp):
+    return "-" if sp is None else ("%.3gx" % sp if sp < 10 else "%.0fx" % sp)
+
+
+def newton_stats(n):
+    st = (n or {}).get("newton") or {}
+    if not st:
+        return "-"
+    return "%s it, %s CG, %s fact.%s" % (
+        st.get("iterations"), st.get("krylov_iterations"), st.get("factorisations"),
+        ", %d load steps" % st["load_steps"] if (st.get("load_steps") or 1) > 1 else "")
+
+
+def agreement_text(n):
+    a = (n or {}).get("agreement") or {}
+    if a.get("max_checked") is None:
+        return a.get("reason", "-") if a else "-"
+    return "%.1e%s" % (a["max_checked"], "" if a.get("ok") else " **FAIL**")
+
+
+def skip_text(n):
+    return "skipped: predicted %.0f GB > %g GB" % (
+        n.get("predicted_memory_gb") or float("nan"),
+        _budget(n))
+
+
+def _budget(n):
+    import re
+    m = re.search(r"the budget ([0-9.]+) GB", n.get("skipped") or "")
+    return float(m.group(1)) if m else 10.0
+
+
+def solver_verdict(pairs):
+    """(sentence, Newton wins at every size with none skipped) for one ladder's pairs."""
+    rows = []
+    for d, n in pairs:
+        k = d["per_thickness"]
+        if n is None:
+            continue
+        if n.get("outcome") == "skipped":
+            rows.append((k, "damped", "Newton not run (predicted %.0f GB)"
+                         % (n.get("predicted_memory_gb") or float("nan")), None))
+            continue
+        sp = speedup(d, n)
+        if sp is None:
+            rows.append((k, "damped" if converged(d) else "?",
+                         "Newton %s" % (n.get("outcome") or n.get("rc")), None))
+            continue
+        rows.append((k, "newton" if sp > 1 else "damped", "%s" % x_text(sp), sp))
+    if not rows:
+        return "no Newton twins run.", False
+    speeds = "; ".join("%d through: %s" % (k, t) for k, _, t, _ in rows)
+    ties = [k for k, _, _, sp in rows if sp is not None and 1 / TIE <= sp <= TIE]
+    tie = (" (within 10 %% at %s through: a tie on the shared machine)" %
+           ", ".join(str(k) for k in ties)) if ties else ""
+    who = [w for _, w, _, _ in rows]
+    ks = [k for k, _, _, _ in rows]
+    if all(w == "newton" for w in who):
+        return ("**Newton wins at every size of the ladder** (%d to %d through; speed-up of "
+                "Newton over the damped solver: %s)%s." % (ks[0], ks[-1], speeds, tie), True)
+    if all(w == "damped" for w in who):
+        return ("**The damped solver wins at every size** (%d to %d through; speed-up of "
+                "Newton: %s)%s." % (ks[0], ks[-1], speeds, tie), False)
+    for i in range(1, len(who)):
+        if all(w == "newton" for w in who[:i]) and all(w == "damped" for w in who[i:]):
+            return ("**Newton wins up to %d through, the damped solver from %d through on** "
+                    "(speed-up of Newton: %s)%s." % (ks[i - 1], ks[i], speeds, tie), False)
+        if all(w == "damped" for w in who[:i]) and all(w == "newton" for w in who[i:]):
+            return ("**The damped solver wins up to %d through, Newton from %d through on** "
+                    "(speed-up of Newton: %s)%s." % (ks[i - 1], ks[i], speeds, tie), False)
+    return ("No clear crossover (speed-up of Newton: %s)%s." % (speeds, tie), False)
+
+
+def solver_table(key, p, runs, variant):
+    """Per resolution: the damped run and its Newton twin (wall time, speed-up, memory, the
+    Newton statistics, and the twin's agreement)."""
+    pairs = solver_pairs(runs, key, variant)
+    if not any(n for _, n in pairs):
+        return []
+    q = (pairs[0][0].get("qoi") or {}).get("primary", "")
+    rows = []
+    for d, n in pairs:
+        skipped = n is not None and n.get("outcome") == "skipped"
+        st = (n or {}).get("newton") or {}
+        rows.append([
+            d["per_thickness"], particles(d), err(d, q),
+            "%s (%s steps)" % (f3(d.get("wall_seconds"), 1), d.get("steps") or "-"),
+            mem(d.get("peak_rss_mb")),
+            skip_text(n) if skipped else (f3((n or {}).get("wall_seconds"), 2) if n else
+                                          "not run"),
+            "-" if skipped or not n else mem(n.get("peak_rss_mb")),
+            x_text(speedup(d, n)),
+            "-" if skipped else newton_stats(n),
+            g(st.get("matrix_nonzeros"), 3), g(st.get("factor_nonzeros"), 3),
+            "-" if skipped or not n else agreement_text(n)])
+    L = ["**Damped dynamics against Newton%s** (the Newton twin: the same run with "
+         "`--static.solver=newton`; wall time as the program measures it; memory = peak "
+         "resident set; K = the assembled stiffness' stored entries (lower triangle), factor = "
+         "its Cholesky factor's entries; last column: the largest relative difference of %s "
+         "between the two, which must be below %g x the static tolerance)" % (
+             (", " + variant_label(p, variant)) if len(p["variants"]) > 1 else "",
+             " and ".join(((p.get("newton") or {}).get("agree") or ["the headline"])),
+             (p.get("newton") or {}).get("agreement_factor", 10)), ""]
+    L += table(["per thickness", "particles (ghosts)", "error %% (%s)" % q,
+                "damped wall s", "damped memory", "Newton wall s", "Newton memory",
+                "speed-up", "Newton: iterations, CG, factorisations", "K entries",
+                "factor entries", "Newton vs damped (rel.)"], rows)
+    L.append("")
+    L.append(solver_verdict(pairs)[0])
+    L.append("")
+    return L
+
+
+def loglog_slope(xs, ys):
+    pts = [(math.log(x), math.log(y)) for x, y in zip(xs, ys) if x and y]
+    if len(pts) < 2:
+        return None
+    mx = sum(a for a, _ in pts) / len(pts)
+    my = sum(b for _, b in pts) / len(pts)
+    sxx = sum((a - mx) ** 2 for a, _ in pts)
+    return sum((a - mx) * (b - my) for a, b in pts) / sxx if sxx > 0 else None
+
+
+def solvers_section(P, runs, meta):
+    static = [(k, p) for k, p in P.items() if p.get("static") and has_twins(runs, k)]
+    if not static:
+        return []
+    nm = meta.get("newton") or {}
+    mt = meta.get("merged_with")
+    while not nm and mt:
+        nm = mt.get("newton") or {}
+        mt = mt.get("merged_with")
+    budget = nm.get("memory_budget_gb", 10.0)
+    factor = nm.get("agreement_factor", 10.0)
+    L = ["## Static problems: damped dynamics or Newton", ""]
+    L.append("Every static ladder run is repeated with `--static.solver=newton` (Newton-Raphson "
+             "on the tangent stiffness K, conjugate gradients preconditioned by a CHOLMOD "
+             "Cholesky factor of the assembled K; docs/static.md), right after its damped run "
+             "so that both see the same machine load. Both stop at the same out-of-balance "
+             "ratio (the scene's `[static] tolerance`, 1e-5), so they reach the same "
+             "equilibrium: the runner checks that every Newton result differs from the damped "
+             "one by less than %g x the tolerance (relative; `--check` enforces it), and the "
+             "errors against the references are then the same, so the two fronts of error "
+             "against wall time differ only in the wall time. A Newton twin whose predicted "
+             "peak memory exceeds %g GB is not run (the runner's model of the factor's growth, "
+             "anchored at measured runs and updated from the twins it has run; `skipped` "
+             "below). Memory is the peak resident set of the run (the kernel's ru_maxrss), "
+             "wall time the program's own. The machine was shared (load average in the "
+             "header), so ratios within 10 %% are ties." % (factor, budget))
+    L.append("")
+    rows = []
+    for key, p in static:
+        for variant in p["variants"]:
+            pairs = solver_pairs(runs, key, variant)
+            if not any(n for _, n in pairs):
+                continue
+            text, everywhere = solver_verdict(pairs)
+            rows.append([short_title(key, p) + ("" if not variant else
+                                                ", " + variant_label(p, variant)),
+                         text, "**yes**" if everywhere else "no"])
+    L.append("**Which solver wins, and from which size on** (generated from the tables in "
+             "each problem's section; speed-up = damped wall time / Newton wall time)")
+    L.append("")
+    L += table(["problem", "verdict", "Newton as the scene's default?"], rows)
+    L.append("")
+    yes = [r[0] for r in rows if r[2] == "**yes**"]
+    no = [r[0] for r in rows if r[2] != "**yes**"]
+    if yes:
+        L.append("Newton is faster at every ladder size of: %s. The damped solver stays the "
+                 "better default for: %s." % ("; ".join(yes), "; ".join(no) or "none"))
+        L.append("")
+    # the sparsity's cost
+    L.append("**What the sparsity of K costs in memory** (default variant of each problem; "
+             "K entries = the stored lower triangle of the assembled stiffness, one entry per "
+             "coupled pair of unknowns: the neighbours of neighbours; factor = the supernodal "
+             "Cholesky factor's entries, 8 bytes each in double precision; the peak resident "
+             "memory of the Newton run holds the factor, K, and the solver's vectors)")
+    L.append("")
+    rows, fits, fac_exp = [], [], {2: [], 3: []}
+    per3, big3, damped_kb = [], [], []  # K entries per particle (3D, 8 through and more),
+    # (particles, fill, factor share of the resident set) of the 3D twins, damped kB/particle
+    for key, p in static:
+        variant = p["variants"][0]
+        pairs = solver_pairs(runs, key, variant)
+        xs, fac, rss_n, rss_d, kk = [], [], [], [], []
+        for d, n in pairs:
+            st = (n or {}).get("newton") or {}
+            npart = (d.get("particles") or 0) + (d.get("ghost_particles") or 0)
+            if n is not None and n.get("outcome") == "skipped":
+                rows.append([short_title(key, p), d["per_thickness"], particles(d), "-", "-",
+                             "-", "-", "-", skip_text(n), mem(d.get("peak_rss_mb")), "-"])
+                continue
+            if not st:
+                continue
+            nz, fz = st.get("matrix_nonzeros"), st.get("factor_nonzeros")
+            rows.append([short_title(key, p), d["per_thickness"], particles(d), g(nz, 3),
+                         f3(nz / float(d["particles"]), 0) if nz and d.get("particles")
+                         else "-", g(fz, 3), f3(fz / float(nz), 1) if fz and nz else "-",
+                         mem(fz * 8 / 1048576.0) if fz else "-", mem(n.get("peak_rss_mb")),
+                         mem(d.get("peak_rss_mb")),
+                         x_text(n["peak_rss_mb"] / d["peak_rss_mb"])
+                         if n.get("peak_rss_mb") and d.get("peak_rss_mb") else "-"])
+            if p.get("dim") == 3 and d["per_thickness"] >= 8 and nz and d.get("particles"):
+                per3.append(nz / float(d["particles"]))
+            if p.get("dim") == 3 and fz and nz and n.get("peak_rss_mb"):
+                big3.append((npart, fz / float(nz),
+                             fz * 8 / 1048576.0 / n["peak_rss_mb"], short_title(key, p),
+                             d["per_thickness"]))
+            xs.append(npart)
+            fac.append(fz)
+            kk.append(nz)
+            rss_n.append(n.get("peak_rss_mb"))
+            rss_d.append(d.get("peak_rss_mb"))
+        if len(xs) >= 2:
+            bf = loglog_slope(xs, fac)
+            if bf is not None and p.get("dim") in fac_exp:
+                fac_exp[p["dim"]].append(bf)
+            fits.append("%s: K %s, factor %s, Newton memory %s" % (
+                short_title(key, p),
+                f3(loglog_slope(xs, kk), 2), f3(bf, 2),
+                f3(loglog_slope(xs[1:] if len(xs) > 2 else xs,
+                                rss_n[1:] if len(xs) > 2 else rss_n), 2)))
+    L += table(["problem", "per thickness", "particles (ghosts)", "K entries",
+                "per particle", "factor entries", "fill (factor / K)", "factor values",
+                "Newton peak memory", "damped peak memory", "Newton / damped memory"], rows)
+    L.append("")
+    if fits:
+        rng = "; ".join("in %dD as N^%.2f to N^%.2f" % (dim, min(v), max(v))
+                        for dim, v in sorted(fac_exp.items(), reverse=True) if v)
+        for key, p in static:
+            for d in ladder(runs, key, p["variants"][0]):
+                if d.get("peak_rss_mb") and d.get("particles", 0) > 20000:
+                    damped_kb.append(d["peak_rss_mb"] * 1024.0 /
+                                     (d["particles"] + (d.get("ghost_particles") or 0)))
+        big3.sort(reverse=True)
+        big = big3[:2]
+        L.append("Growth with the particle count N (particles and ghosts; least-squares "
+                 "exponent b in `~ N^b` over the twins run; the memory's over all but the "
+                 "coarsest, whose resident set is mostly the program itself, about 30 MB): " +
+                 "; ".join(fits) + ". K grows nearly as N: a bounded number of neighbours of "
+                 "neighbours per particle (%s; fewer at coarse sizes, where a larger share of "
+                 "the particles sits at a surface). The factor grows faster, by the fill-in of "
+                 "the elimination: %s over these ladders. The factor, not K, is what costs: "
+                 "%s. The damped solver stores no matrix: its memory grows as N (%s)." % (
+                     "in 3D %.0f-%.0f stored entries per particle from 8 through on" % (
+                         min(per3), max(per3)) if per3 else "-", rng,
+                     "; ".join("%s at %d through (%d particles with ghosts): factor %.1f times "
+                               "K's entries, its values %.0f %% of the run's peak resident "
+                               "memory" % (t, k, n_, fill, 100 * share)
+                               for n_, fill, share, t, k in big) or "-",
+                     "%.1f-%.1f kB per particle with ghosts above 20,000 particles" % (
+                         min(damped_kb), max(damped_kb)) if damped_kb else "-"))
+        L.append("")
+    sk = [r for r in runs if is_newton(r) and r.get("outcome") == "skipped"]
+    if sk:
+        L.append("Not run (predicted memory over the %g GB budget): %s." % (
+            budget, "; ".join("`%s` (%s)" % (r["id"], r.get("skipped", "")) for r in sk)))
+        L.append("")
+    return L
 
 
 def meshes_text(meshes):
@@ -872,6 +1204,7 @@ def problem_section(key, p, runs, R):
             L += table(["error", "observed order between resolutions",
                         "Richardson, last three (self-convergence)"], conv_rows)
             L.append("")
+        L += solver_table(key, p, runs, variant)
     L += field_section(key, p, runs)
     return L
 
@@ -884,7 +1217,7 @@ def field_section(key, p, runs):
     """'Field errors against FEM': the `tlsph compare` norms of each ladder run's final
     frame (run.py stores them in the record's `fields`)."""
     recs = [r for r in runs if r["problem"] == key and r["kind"] == "ladder" and
-            isinstance(r.get("fields"), dict)]
+            isinstance(r.get("fields"), dict) and not is_newton(r)]
     if not recs:
         return []
     recs.sort(key=lambda r: (p["variants"].index(r["variant"])
@@ -1188,6 +1521,14 @@ def cuts_section(P, runs):
              "across the hole.")
     L.append("- The problems with CalculiX references only (large-deflection cantilever, "
              "Cook's membranes, plate with a hole) have no sensitivity studies.")
+    sk = [r for r in runs if is_newton(r) and r.get("outcome") == "skipped"]
+    if sk:
+        L.append("- Newton twins not run because their predicted peak memory exceeds the "
+                 "budget (the machine has 24 GB and is shared): %s. The damped solver's runs "
+                 "at those sizes are in the tables." % "; ".join(
+                     "%s at %d through (%.0f GB predicted)" % (
+                         r["problem"], r["per_thickness"], r.get("predicted_memory_gb") or 0)
+                     for r in sk))
     L.append("")
     return L
 
@@ -1214,6 +1555,82 @@ def short_title(key, p):
     return t + (" (nu = 0.4999)" if key == "cook_membrane_incompressible" else "")
 
 
+def solver_plots(plt, np, runs, P, report_dir, colours):
+    """static_solvers.png: per static problem both fronts (error against wall time), and the
+    memory of both solvers against the particle count."""
+    from matplotlib.ticker import FuncFormatter
+    static = [(k, p) for k, p in P.items() if p.get("static") and has_twins(runs, k)]
+    if not static:
+        return []
+    n = len(static) + 1
+    ncol = 4
+    nrow = (n + ncol - 1) // ncol
+    fig, axes = plt.subplots(nrow, ncol, figsize=(4.2 * ncol, 3.6 * nrow), squeeze=False)
+    for ax in axes.flat[n:]:
+        ax.set_visible(False)
+    for ax, (key, p) in zip(axes.flat, static):
+        variant = p["variants"][0]
+        pairs = solver_pairs(runs, key, variant)
+        for solver, style, colour in (("damped", "o-", colours[0]), ("newton", "D--",
+                                                                      colours[1])):
+            rs = [d if solver == "damped" else nn for d, nn in pairs]
+            rs = [r for r in rs if r and primary_error(r) is not None and r.get("wall_seconds")]
+            if not rs:
+                continue
+            x = [r["wall_seconds"] for r in rs]
+            y = [max(abs(primary_error(r)), 1e-3) for r in rs]
+            ax.loglog(x, y, style, color=colour, mfc="white" if solver == "newton" else None,
+                      label=solver)
+            for r, xx, yy in zip(rs, x, y):
+                ax.annotate("%d" % r["per_thickness"], (xx, yy), textcoords="offset points",
+                            xytext=(4, 4) if solver == "damped" else (5, -10), fontsize=7,
+                            color=colour)
+        skipped = [d["per_thickness"] for d, nn in pairs
+                   if nn is not None and nn.get("outcome") == "skipped"]
+        q = (pairs[0][0].get("qoi") or {}).get("primary", "") if pairs else ""
+        ax.set_title("%s [%s]%s" % (short_title(key, p), q,
+                                    "\nNewton not run at %s through (memory)" %
+                                    ", ".join(map(str, skipped)) if skipped else ""),
+                     fontsize=8.5)
+        ax.set_xlabel("wall time [s]", fontsize=8)
+        ax.set_ylabel("|error| [%]", fontsize=8)
+        ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: "%g" % v))
+        ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: "%g" % v))
+        ax.yaxis.set_minor_formatter(FuncFormatter(lambda v, _: _minor_label(v, "2346")))
+        ax.tick_params(labelsize=7)
+        ax.tick_params(axis="y", which="minor", labelsize=6)
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=7)
+    ax = axes.flat[len(static)]
+    for i, (key, p) in enumerate(static):
+        pairs = solver_pairs(runs, key, p["variants"][0])
+        c = colours[i % len(colours)]
+        for solver, style in (("damped", "o-"), ("newton", "D--")):
+            pts = [((d.get("particles") or 0) + (d.get("ghost_particles") or 0),
+                    (d if solver == "damped" else nn).get("peak_rss_mb"))
+                   for d, nn in pairs if (d if solver == "damped" else nn) is not None]
+            pts = [(a, b) for a, b in pts if a and b]
+            if pts:
+                ax.loglog([a for a, _ in pts], [b for _, b in pts], style, color=c,
+                          mfc="white" if solver == "newton" else None,
+                          label=short_title(key, p) if solver == "damped" else None)
+    ax.set_xlabel("particles (with ghosts)", fontsize=8)
+    ax.set_ylabel("peak resident memory [MB]", fontsize=8)
+    ax.set_title("memory: damped (solid) and Newton (dashed)", fontsize=8.5)
+    ax.tick_params(labelsize=7)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=6)
+    fig.tight_layout()
+    fig.savefig(report_dir / "static_solvers.png", dpi=110)
+    plt.close(fig)
+    return [("static_solvers.png",
+             "each static problem's two fronts, headline |error| against wall time: the damped "
+             "solver (circles) and Newton (open diamonds), labelled by particles per "
+             "thickness; the errors agree (the twins' check), so a front to the left is the "
+             "faster solver at that size. Last panel: peak resident memory of both solvers "
+             "against the particle count (Newton's grows with the Cholesky factor's fill).")]
+
+
 def make_plots(data, report_dir):
     import matplotlib
 
@@ -1228,7 +1645,7 @@ def make_plots(data, report_dir):
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
 
     # 1. error against wall time
-    fig, ax = plt.subplots(figsize=(8.5, 6))
+    fig, ax = plt.subplots(figsize=(12.5, 6.5))
     for i, (key, p) in enumerate(P.items()):
         for j, variant in enumerate(plot_variants(p)):
             lad = [r for r in ladder(runs, key, variant)
@@ -1244,6 +1661,19 @@ def make_plots(data, report_dir):
             for r, xx, yy in zip(lad, x, y):
                 ax.annotate("%d" % r["per_thickness"], (xx, yy), textcoords="offset points",
                             xytext=(4, 4), fontsize=7, color=colours[i % len(colours)])
+            # the static ladders' Newton front (the twins that ran), same colour, dotted
+            nl = [r for r in ladder(runs, key, variant, solver="newton")
+                  if primary_error(r) is not None and r.get("wall_seconds")]
+            if nl:
+                ax.loglog([r["wall_seconds"] for r in nl],
+                          [max(abs(primary_error(r)), 1e-3) for r in nl], "D:",
+                          color=colours[i % len(colours)], mfc="white",
+                          label=short_title(key, p) + " Newton")
+                for r in nl:
+                    ax.annotate("%d" % r["per_thickness"],
+                                (r["wall_seconds"], max(abs(primary_error(r)), 1e-3)),
+                                textcoords="offset points", xytext=(-10, -9), fontsize=6.5,
+                                color=colours[i % len(colours)])
     ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: "%g" % v))
     ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: "%g" % v))
     ax.yaxis.set_minor_formatter(FuncFormatter(lambda v, _: _minor_label(v, "25")))
@@ -1252,7 +1682,7 @@ def make_plots(data, report_dir):
     ax.set_ylabel("|error| against the reference [%]")
     ax.set_title("Error against run time (labels: particles through the thickness)")
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7.5, loc="best")
+    ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5))
     fig.tight_layout()
     fig.savefig(report_dir / "error_vs_wall_time.png", dpi=110)
     plt.close(fig)
@@ -1261,7 +1691,11 @@ def make_plots(data, report_dir):
                 "per resolution (labelled by particles through the thickness), at the "
                 "defaults (the cantilevers' alpha variants are in the alpha-spread table). "
                 "The static cantilever, the clamped plate and the problems with CalculiX "
-                "references only are against the converged FEM values."))
+                "references only are against the converged FEM values. Static problems: "
+                "solid line = the damped solver (the scenes' default), dotted line with open "
+                "diamonds = Newton (`--static.solver=newton`; same errors, other wall "
+                "times; a size whose Newton run was skipped for memory has no diamond)."))
+    out += solver_plots(plt, np, runs, P, report_dir, colours)
 
     # 2. error against dx, with the fitted slope
     keys = [k for k in P.keys() if k in CONVERGENCE]

@@ -29,6 +29,16 @@ validation/report/README.md and the PNG plots are made from that file (numpy and
 are needed for the plots only). Exit status 4 (unstable) or 3 (static run not converged) is a
 result to report, not a failure of the runner.
 
+Static problems are solved twice at every ladder resolution: with the scene's solver (the
+damped dynamics, `[static] solver = damped`) and again with `--static.solver=newton` (a
+"Newton twin", id `<ladder id>-newton`, record field `solver`). A twin is skipped, and recorded
+as skipped, when its predicted peak memory exceeds --newton-memory-gb (default 10 GB: the
+Cholesky factor grows faster than the particle count, see NEWTON_MEMORY below). Each twin's
+result must agree with its damped run: the relative difference of the problem's headline
+values below NEWTON_AGREEMENT times the static tolerance (--check enforces it; the quick check
+runs a few tiny twins). Every run's peak resident memory is measured (wait4's ru_maxrss), and a
+run above --memory-limit-gb is stopped.
+
 Running, parsing and checking use the Python standard library only (CI has no numpy).
 """
 
@@ -40,6 +50,7 @@ import platform
 import shlex
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -543,7 +554,8 @@ class Problem:
     def __init__(self, key, title, scene, dim, thickness, ladder, quick_dx, sens_dx, extract,
                  static, qoi, unit, target=None, variants=None, sensitivity=None,
                  checked=None, cross=None, quick_variant=0, sens_variant=0,
-                 variant_ladders=None, clamps=None):
+                 variant_ladders=None, clamps=None, newton_memory=None, quick_newton=False,
+                 agree=None):
         self.key, self.title, self.scene, self.dim = key, title, scene, dim
         self.thickness, self.ladder = thickness, ladder
         self.quick_dx, self.sens_dx = quick_dx, sens_dx
@@ -557,6 +569,12 @@ class Problem:
         self.sens_variant = sens_variant  # the variant the sensitivity studies start from
         self.variant_ladders = variant_ladders or {}  # variant -> its own (shorter) ladder
         self.clamps = clamps or []  # the scene's [clamp.NAME] sections (the clamp.method study)
+        # static problems: the Newton twins' memory model (n_ref per thickness, peak GB there,
+        # exponent of n; NEWTON_MEMORY), whether the quick check runs the quick run's twin, and
+        # the values (qoi["values"]) whose Newton-damped agreement is checked
+        self.newton_memory = newton_memory
+        self.quick_newton = quick_newton
+        self.agree = agree or []
 
 
 # The 3D problems' sensitivity studies run at the coarsest ladder resolution (4 per thickness),
@@ -592,6 +610,32 @@ ALPHA_VARIANTS = [("alpha1", {"hourglass.alpha": "1"}), ("alpha30", {"hourglass.
 DYNAMIC_ALPHA_LADDER = [0.025, 0.0125]  # 10 through cut (budget)
 STATIC_ALPHA_LADDER = [0.025, 0.0125, 0.01, 0.1 / 12]  # 16 through cut (budget)
 
+# Newton twins of the static ladders (`--static.solver=newton`). Their memory is the sparse
+# Cholesky factor of the assembled stiffness: it grows faster than the particle count, so each
+# static problem has a model of the peak resident memory, GB(n) = GB_ref (n / n_ref)^exponent
+# (n = particles per thickness), anchored at a run measured with /usr/bin/time on the 2-core
+# machine (commit 259a8de, 2 threads, 2026-11-28; the clamped plate's from docs/static.md:
+# 0.46, 2.4, 7.8 GB at 4, 6, 8 through, exponent 4.1 in n). The runner predicts each twin's
+# memory from the finest twin of the same problem it has measured so far (else from this
+# anchor), with the larger of the model's exponent and the one observed between the two
+# finest measured twins, and skips the twin when the prediction exceeds --newton-memory-gb.
+NEWTON_BUDGET_GB = 10.0
+MEMORY_LIMIT_GB = 10.5  # any run (damped or Newton) above this resident size is stopped
+NEWTON_MEMORY = {
+    "cantilever_static": (12, 1.57, 4.5),  # 0.31, 0.69, 1.57, 5.58 GB at 8, 10, 12, 16
+    "cantilever_large": (8, 0.32, 4.5),
+    "clamped_plate": (8, 7.8, 4.1),
+    "csm1": (16, 0.056, 2.5),  # 2D: the factor grows about as N log N; 2.5 is a bound
+    "cook_membrane": (32, 0.12, 2.5),
+    "cook_membrane_incompressible": (32, 0.12, 2.5),
+    "plate_hole": (16, 0.38, 2.5),
+}
+# A twin agrees with its damped run when every checked value differs by less than
+# NEWTON_AGREEMENT times the static tolerance (relative): both stop at an out-of-balance ratio
+# below the tolerance, and the displacement error that leaves is of the same order (measured:
+# 1e-7 to 4e-5 relative at tolerance 1e-5).
+NEWTON_AGREEMENT = 10.0
+
 PROBLEMS = [
     Problem("oscillating_plate", "Oscillating plate (Gray, Monaghan & Swift 2001), 2D",
             "oscillating_plate.ini", 2, 0.02, [0.005, 0.0025, 0.00125], 0.005, 0.0025,
@@ -608,7 +652,9 @@ PROBLEMS = [
             sensitivity=dict({"kernel.support": SUPPORT, "kernel.correction": LINEAR,
                               "time.cfl": CFL, "static.tolerance": TOL},
                              **hourglass_studies(True)),
-            checked=["tip_vs_fem", "tip", "tip_extrapolated"], clamps=["root"]),
+            checked=["tip_vs_fem", "tip", "tip_extrapolated"], clamps=["root"],
+            newton_memory=NEWTON_MEMORY["cantilever_static"], quick_newton=True,
+            agree=["tip"]),
     Problem("cantilever_dynamic", "Cantilever, gravity applied suddenly, 3D",
             "cantilever_dynamic.ini", 3, 0.1, [0.025, 0.0125, 0.01], 0.025, 0.025,
             extract_cantilever_dynamic, False, "first bending frequency", "Hz",
@@ -624,7 +670,8 @@ PROBLEMS = [
             sensitivity=dict({"kernel.support": SUPPORT, "kernel.correction": LINEAR,
                               "time.cfl": CFL, "static.tolerance": TOL},
                              **hourglass_studies(True)),
-            checked=["displacement", "ux", "uy"], clamps=["root"]),
+            checked=["displacement", "ux", "uy"], clamps=["root"],
+            newton_memory=NEWTON_MEMORY["csm1"], quick_newton=True, agree=["ux", "uy"]),
     Problem("csm3", "Turek & Hron CSM3, dynamic, 2D", "turek_hron_csm3.ini", 2, 0.02,
             [0.005, 0.0025, 0.00125], 0.005, 0.0025, extract_csm3, False,
             "frequency", "Hz", target=("frequency", 2.0),
@@ -638,27 +685,34 @@ PROBLEMS = [
             sensitivity=dict({"kernel.support": SUPPORT, "kernel.correction": LINEAR,
                               "time.cfl": CFL, "static.tolerance": TOL},
                              **hourglass_studies(True)),
-            checked=["w_vs_fem"], clamps=["left", "right", "front", "back"]),
+            checked=["w_vs_fem"], clamps=["left", "right", "front", "back"],
+            newton_memory=NEWTON_MEMORY["clamped_plate"], agree=["w"]),
     # The problems with CalculiX references only (validation/fem.py): ladders, no sensitivity
     # studies (budget). "Per thickness": through the section (cantilever), along the loaded
     # edge (Cook, 0.016 m), across the hole's diameter (plate with a hole, 0.02 m).
     Problem("cantilever_large", "Cantilever under a large self-weight (g = 30), static, 3D",
             "cantilever_large.ini", 3, 0.1, [0.025, 0.0125, 0.01], 0.025, 0.025,
             extract_cantilever_large, True, "tip displacement u_z", "m",
-            checked=["tip_uz", "tip_ux"], clamps=["root"]),
+            checked=["tip_uz", "tip_ux"], clamps=["root"],
+            newton_memory=NEWTON_MEMORY["cantilever_large"], quick_newton=True,
+            agree=["tip_uz", "tip_ux"]),
     Problem("cook_membrane", "Cook's membrane, plane strain, nu = 0.3, static, 2D",
             "cook_membrane.ini", 2, 0.016, [0.002, 0.001, 0.0005], 0.002, 0.002,
             extract_cook("cook_membrane"), True, "corner displacement u_y", "m",
-            checked=["corner_uy", "corner_ux"], clamps=["left"]),
+            checked=["corner_uy", "corner_ux"], clamps=["left"],
+            newton_memory=NEWTON_MEMORY["cook_membrane"], agree=["corner_uy", "corner_ux"]),
     Problem("cook_membrane_incompressible",
             "Cook's membrane, nearly incompressible (nu = 0.4999), static, 2D",
             "cook_membrane_incompressible.ini", 2, 0.016, [0.002, 0.001, 0.0005], 0.002, 0.002,
             extract_cook("cook_membrane_incompressible"), True, "corner displacement u_y", "m",
-            checked=["corner_uy", "corner_ux"], clamps=["left"]),
+            checked=["corner_uy", "corner_ux"], clamps=["left"],
+            newton_memory=NEWTON_MEMORY["cook_membrane_incompressible"], quick_newton=True,
+            agree=["corner_uy", "corner_ux"]),
     Problem("plate_hole", "Plate with a central hole in tension, plane strain, static, 2D",
             "plate_hole.ini", 2, 0.02, [0.0025, 0.00125, 0.000625], 0.0025, 0.0025,
             extract_plate_hole, True, "end displacement u_x", "m",
-            checked=["end_ux", "kt_top"], clamps=["left"]),
+            checked=["end_ux", "kt_top"], clamps=["left"],
+            newton_memory=NEWTON_MEMORY["plate_hole"], agree=["end_ux", "kt_top"]),
 ]
 BY_KEY = {p.key: p for p in PROBLEMS}
 DEFAULTS = {"kernel.support": 2.1, "kernel.correction": "quadratic", "hourglass.alpha": 10.0,
@@ -682,7 +736,7 @@ def per_thickness(problem, dx):
     return int(round(problem.thickness / dx))
 
 
-def run_id(problem, variant, dx, param=None, value=None):
+def run_id(problem, variant, dx, param=None, value=None, solver=None):
     parts = [problem.key]
     if variant:
         parts.append(variant)
@@ -691,6 +745,8 @@ def run_id(problem, variant, dx, param=None, value=None):
         parts += ["%s%s" % (SHORT[k], fmt(v)) for k, v in value.items()]
     elif param:
         parts.append("%s%s" % (SHORT[param], fmt(value)))
+    if solver == "newton":
+        parts.append("newton")
     return "-".join(parts)
 
 
@@ -702,23 +758,34 @@ def study_overrides(problem, param, value):
     return {param: "%g" % value if param == "static.tolerance" else fmt(value)}
 
 
-def plan_runs(quick, sensitivity, only):
-    """The runs to do, in order: ladders (coarse to fine), then sensitivities. A sensitivity
+def plan_runs(quick, sensitivity, only, newton=True):
+    """The runs to do, in order: ladders (coarse to fine; a static problem's Newton twin right
+    after its damped run, under the same machine load), then sensitivities. A sensitivity
     run with the same settings as a ladder run (an alpha variant at the sensitivity
-    resolution) is not run twice: the report takes the ladder run."""
+    resolution) is not run twice: the report takes the ladder run. The quick plan has the
+    twins of the problems marked quick_newton only (tiny runs)."""
     runs = []
+
+    def ladder_run(p, name, ov, dx, with_twin):
+        solver = "damped" if p.static else None
+        runs.append(dict(problem=p.key, variant=name, dx=dx, kind="ladder", param=None,
+                         value=None, overrides=dict(ov), solver=solver))
+        if p.static and newton and with_twin:
+            o = dict(ov)
+            o["static.solver"] = "newton"
+            runs.append(dict(problem=p.key, variant=name, dx=dx, kind="ladder", param=None,
+                             value=None, overrides=o, solver="newton"))
+
     for p in PROBLEMS:
         if only and p.key not in only:
             continue
         if quick:
             name, ov = p.variants[p.quick_variant]
-            runs.append(dict(problem=p.key, variant=name, dx=p.quick_dx, kind="ladder",
-                             param=None, value=None, overrides=dict(ov)))
+            ladder_run(p, name, ov, p.quick_dx, p.quick_newton)
             continue
         for name, ov in p.variants:
             for dx in p.variant_ladders.get(name, p.ladder):
-                runs.append(dict(problem=p.key, variant=name, dx=dx, kind="ladder", param=None,
-                                 value=None, overrides=dict(ov)))
+                ladder_run(p, name, ov, dx, True)
     done = {(r["problem"], r["dx"], tuple(sorted(r["overrides"].items()))) for r in runs}
     if not quick and sensitivity:
         for p in PROBLEMS:
@@ -732,16 +799,103 @@ def plan_runs(quick, sensitivity, only):
                     if (p.key, p.sens_dx, tuple(sorted(o.items()))) in done:
                         continue
                     runs.append(dict(problem=p.key, variant=name, dx=p.sens_dx,
-                                     kind="sensitivity", param=param, value=v, overrides=o))
+                                     kind="sensitivity", param=param, value=v, overrides=o,
+                                     solver="damped" if p.static else None))
             for combo in p.cross:
                 o = dict(ov)
                 o.update({k: fmt(v) for k, v in combo.items()})
                 runs.append(dict(problem=p.key, variant=name, dx=p.sens_dx, kind="cross",
-                                 param="+".join(combo), value=dict(combo), overrides=o))
+                                 param="+".join(combo), value=dict(combo), overrides=o,
+                                 solver="damped" if p.static else None))
     for r in runs:
         p = BY_KEY[r["problem"]]
-        r["id"] = run_id(p, r["variant"], r["dx"], r["param"], r["value"])
+        r["id"] = run_id(p, r["variant"], r["dx"], r["param"], r["value"], r.get("solver"))
+        if r.get("solver") == "newton":
+            r["damped_twin"] = run_id(p, r["variant"], r["dx"], r["param"], r["value"])
     return runs
+
+
+# --------------------------------------------------------------------------------------------
+# Newton twins: memory prediction and agreement with the damped run
+
+
+def predict_newton_gb(problem, n, measured):
+    """Predicted peak resident memory [GB] of the problem's Newton twin at n per thickness,
+    and how it was predicted. measured: [(n, GB)] of the problem's twins measured so far."""
+    n0, gb0, expo = problem.newton_memory or (None, None, None)
+    pts = sorted((m, gb) for m, gb in measured if gb)
+    basis = "model %g GB at %d through, exponent %g" % (gb0, n0, expo) if n0 else None
+    if pts:
+        n1, gb1 = pts[-1]
+        lower = [q for q in pts if q[0] < n1]
+        if lower and expo is not None:
+            obs = math.log(gb1 / lower[-1][1]) / math.log(n1 / lower[-1][0])
+            expo = max(expo, obs)
+        elif expo is None:
+            expo = 3.0 * problem.dim / 2.0
+        n0, gb0 = n1, gb1
+        basis = "measured %.3g GB at %d through, exponent %.2f" % (gb1, n1, expo)
+    if n0 is None:
+        return None, "no model"
+    return gb0 * (n / float(n0)) ** expo, basis
+
+
+def scene_value(scene, section, key):
+    """A key of a scene file's section (text, comments stripped), or None."""
+    current = None
+    for line in Path(scene).read_text().splitlines():
+        line = line.split("#", 1)[0].split(";", 1)[0].strip()
+        if line.startswith("[") and line.endswith("]"):
+            current = line[1:-1].strip()
+        elif current == section and "=" in line:
+            k, v = (x.strip() for x in line.split("=", 1))
+            if k == key:
+                return v
+    return None
+
+
+def static_tolerance(problem, run):
+    v = run["overrides"].get("static.tolerance") or scene_value(
+        ROOT / "validation" / "scenes" / problem.scene, "static", "tolerance")
+    return float(v) if v else 1e-5  # the program's default
+
+
+def agreement(problem, newton_rec, damped_rec):
+    """The Newton twin's values against its damped run's: relative differences of every value
+    and the check of the problem's agree-values against NEWTON_AGREEMENT x the tolerance."""
+    tol = static_tolerance(problem, damped_rec)
+    out = {"damped_run": damped_rec["id"], "static_tolerance": tol,
+           "limit": NEWTON_AGREEMENT * tol, "checked": {}, "relative_differences": {}}
+    qn, qd = newton_rec.get("qoi"), damped_rec.get("qoi")
+    if not qn or not qd:
+        out["ok"] = False
+        out["reason"] = "no result: newton %s, damped %s" % (
+            newton_rec.get("outcome") or newton_rec.get("rc"),
+            damped_rec.get("outcome") or damped_rec.get("rc"))
+        return out
+    for k, vn in qn["values"].items():
+        vd = qd["values"].get(k)
+        if (isinstance(vn, float) and isinstance(vd, float) and math.isfinite(vn) and
+                math.isfinite(vd) and vd != 0):
+            out["relative_differences"][k] = (vn - vd) / abs(vd)
+    for k in problem.agree:
+        out["checked"][k] = out["relative_differences"].get(k)
+    vals = list(out["checked"].values())
+    out["max_checked"] = max(abs(v) for v in vals) if vals and None not in vals else None
+    out["ok"] = bool(out["max_checked"] is not None and out["max_checked"] <= out["limit"] and
+                     newton_rec.get("outcome") == "converged")
+    return out
+
+
+def skipped_newton(problem, run, predicted, basis, budget, git):
+    rec = dict(run)
+    rec.pop("compare_fields", None)
+    rec.update(command=None, git=git["commit"], per_thickness=per_thickness(problem, run["dx"]),
+               rc=None, outcome="skipped", qoi=None, wall_runner=0.0, reused=False,
+               predicted_memory_gb=predicted, memory_prediction=basis,
+               skipped="predicted peak memory %.1f GB > the budget %g GB (%s)" % (
+                   predicted, budget, basis))
+    return rec
 
 
 # --------------------------------------------------------------------------------------------
@@ -822,7 +976,7 @@ def wants_fields(problem, run):
     """Field comparison with the FEM: ladder runs of the static problems that have an FEM
     VTU, in the full validation only (the quick check writes no frames)."""
     return bool(run.get("compare_fields") and run["kind"] == "ladder" and
-                problem.key in FIELD_PROBLEMS)
+                problem.key in FIELD_PROBLEMS and run.get("solver") != "newton")
 
 
 def build_command(problem, run, build_dir, runs_dir):
@@ -847,7 +1001,66 @@ def build_command(problem, run, build_dir, runs_dir):
     return argv, outdir, " ".join(shlex.quote(a) for a in shown)
 
 
-def execute(problem, run, build_dir, runs_dir, R, git, reuse, timeout):
+def rss_kb(pid):
+    try:
+        with open("/proc/%d/status" % pid) as f:
+            for line in f:
+                if line.startswith("VmRSS:"):
+                    return int(line.split()[1])
+    except (OSError, ValueError, IndexError):
+        pass
+    return 0
+
+
+def run_measured(argv, env, timeout, memory_limit_gb, log_dir):
+    """Runs argv with stdout and stderr to files in log_dir. Returns (rc, stderr text, peak
+    resident memory in MB or None). rc is "timeout" or "memory-limit" when the watchdog
+    stopped the run (after `timeout` s, or above `memory_limit_gb` resident). The peak is the
+    child's ru_maxrss (wait4), the kernel's count of its largest resident set."""
+    out_path, err_path = log_dir / "runner_stdout.txt", log_dir / "runner_stderr.txt"
+    with open(out_path, "w") as out, open(err_path, "w") as err:
+        proc = subprocess.Popen(argv, cwd=ROOT, env=env, stdout=out, stderr=err)
+    stop, why = threading.Event(), []
+    limit_kb = memory_limit_gb * 1024 * 1024 if memory_limit_gb else None
+
+    def watch():
+        t0 = time.monotonic()
+        while not stop.wait(0.2):
+            if time.monotonic() - t0 > timeout:
+                why.append("timeout")
+            elif limit_kb and rss_kb(proc.pid) > limit_kb:
+                why.append("memory-limit")
+            if why:
+                try:
+                    os.kill(proc.pid, 9)  # the child only: it is not reaped before stop is set
+                except OSError:
+                    pass
+                return
+
+    th = threading.Thread(target=watch, daemon=True)
+    th.start()
+    try:
+        os.waitid(os.P_PID, proc.pid, os.WEXITED | os.WNOWAIT)  # exited, not yet reaped
+    finally:
+        stop.set()
+        th.join()
+    _, status, usage = os.wait4(proc.pid, 0)
+    proc.returncode = os.waitstatus_to_exitcode(status)
+    rc = why[0] if why else proc.returncode
+    try:
+        err_text = err_path.read_text(errors="replace")
+    except OSError:
+        err_text = ""
+    err_text = err_text[:2000]
+    if why:
+        err_text += "\nkilled by validation/run.py: %s (%s)" % (
+            why[0], "after %s s" % timeout if why[0] == "timeout" else
+            "resident memory above %g GB" % memory_limit_gb)
+    return rc, err_text, usage.ru_maxrss / 1024.0
+
+
+def execute(problem, run, build_dir, runs_dir, R, git, reuse, timeout,
+            memory_limit_gb=MEMORY_LIMIT_GB):
     argv, outdir, shown = build_command(problem, run, build_dir, runs_dir)
     rec = dict(run)
     rec.pop("compare_fields", None)
@@ -862,7 +1075,8 @@ def execute(problem, run, build_dir, runs_dir, R, git, reuse, timeout):
             if (old.get("argv") == argv and old.get("rc") in (0, 3, 4) and
                     sidecar.stat().st_mtime > scene_changed):
                 rec.update(rc=old["rc"], wall_runner=old["wall_runner"],
-                           loadavg=old.get("loadavg"), git=old.get("git", git["commit"]))
+                           loadavg=old.get("loadavg"), git=old.get("git", git["commit"]),
+                           peak_rss_mb=old.get("peak_rss_mb"))
                 if old.get("stderr"):
                     rec["stderr"] = old["stderr"]
                 reused = True
@@ -880,21 +1094,18 @@ def execute(problem, run, build_dir, runs_dir, R, git, reuse, timeout):
         env.pop("CI", None)
         load0 = os.getloadavg()[0]
         t0 = time.monotonic()
-        try:
-            proc = subprocess.run(argv, cwd=ROOT, env=env, capture_output=True, text=True,
-                                  timeout=timeout)
-            rc, err = proc.returncode, (proc.stderr or "")[:2000]
-        except subprocess.TimeoutExpired:
-            rc, err = "timeout", "killed after %s s" % timeout
+        rc, err, peak = run_measured(argv, env, timeout, memory_limit_gb, outdir)
         wall = time.monotonic() - t0
-        rec.update(rc=rc, wall_runner=wall, loadavg=[load0, os.getloadavg()[0]])
+        rec.update(rc=rc, wall_runner=wall, loadavg=[load0, os.getloadavg()[0]],
+                   peak_rss_mb=peak)
         # An unstable run (exit 4) is a result: its stderr is the guard's message (what,
         # where, the likely cause), kept with the record; so is a failure's.
         if rc != 0 and err.strip():
             rec["stderr"] = err
         sidecar.write_text(json.dumps({"argv": argv, "rc": rc, "wall_runner": wall,
                                        "loadavg": rec["loadavg"], "git": git["commit"],
-                                       "stderr": rec.get("stderr")}, indent=1))
+                                       "peak_rss_mb": peak, "stderr": rec.get("stderr")},
+                                      indent=1))
     rec["reused"] = reused
     summary = {}
     try:
@@ -906,7 +1117,8 @@ def execute(problem, run, build_dir, runs_dir, R, git, reuse, timeout):
               "neighbours_max", "support_over_dx", "hourglass_alpha", "hourglass_form",
               "hourglass_gradient", "cfl", "dt", "dt_rule_hourglass_speed",
               "dt_rule_limited_by", "steps", "simulated_time", "wall_seconds", "threads",
-              "outcome", "residual", "particle_steps_per_second", "instability"):
+              "outcome", "residual", "particle_steps_per_second", "instability",
+              "static_solver", "newton"):
         rec[k] = summary.get(k)
     rec["qoi"] = None
     try:
@@ -1023,7 +1235,13 @@ def problems_table():
                     "quick_variant": p.variants[p.quick_variant][0],
                     "sensitivity_variant": p.variants[p.sens_variant][0],
                     "variant_ladders": p.variant_ladders,
-                    "sensitivity": p.sensitivity, "cross": p.cross}
+                    "sensitivity": p.sensitivity, "cross": p.cross,
+                    "newton": ({"memory_model": dict(zip(("n_ref", "gb_ref", "exponent"),
+                                                         p.newton_memory))
+                                if p.newton_memory else None,
+                                "agree": p.agree, "quick": p.quick_newton,
+                                "agreement_factor": NEWTON_AGREEMENT}
+                               if p.static else None)}
             for p in PROBLEMS}
 
 
@@ -1063,6 +1281,30 @@ def derive_tolerances(results, path):
     }
     save_json(path, data)
     return data
+
+
+def check_agreement(records):
+    """Returns (rows, ok): each Newton twin's agreement with its damped run (execute() stored
+    it in the twin's record). rows: (run id, value, relative difference, limit, verdict). A
+    twin skipped for memory is no failure; one that ran and does not agree (or did not
+    converge) is."""
+    rows, ok = [], True
+    for r in records:
+        if r.get("solver") != "newton" or r.get("outcome") == "skipped":
+            continue
+        a = r.get("agreement") or {}
+        if not a.get("checked"):
+            rows.append((r["id"], "-", None, a.get("limit"),
+                         "FAIL (%s)" % (a.get("reason") or "no damped run to compare with")))
+            ok = False
+            continue
+        conv = r.get("outcome") == "converged"
+        for name, d in a["checked"].items():
+            good = d is not None and abs(d) <= a["limit"] and conv
+            ok &= good
+            rows.append((r["id"], name, d, a["limit"],
+                         "ok" if good else "FAIL" + ("" if conv else " (%s)" % r.get("outcome"))))
+    return rows, ok
 
 
 def check_against(tolerances, records):
@@ -1180,6 +1422,14 @@ def main(argv=None):
                          "newer than its scene file (for development and for resuming an "
                          "interrupted ladder: the binary and commit are not compared)")
     ap.add_argument("--timeout", type=float, default=3600.0, help="seconds per run")
+    ap.add_argument("--no-newton", action="store_true",
+                    help="no Newton twins of the static ladders")
+    ap.add_argument("--newton-memory-gb", type=float, default=NEWTON_BUDGET_GB,
+                    help="skip a Newton twin whose predicted peak memory exceeds this "
+                         "(default %(default)s GB)")
+    ap.add_argument("--memory-limit-gb", type=float, default=MEMORY_LIMIT_GB,
+                    help="stop any run whose resident memory exceeds this (default "
+                         "%(default)s GB; 0: no limit)")
     ap.add_argument("--no-fem", action="store_true",
                     help="full validation: do not regenerate the FEM references with "
                          "validation/fem.py (CalculiX); use the committed "
@@ -1217,15 +1467,23 @@ def main(argv=None):
 
     runs_dir = Path(args.runs_dir) if args.runs_dir else (
         HERE / "runs" / "quick" if args.quick else HERE / "runs")
-    plan = plan_runs(args.quick, not args.no_sensitivity, only)
+    plan = plan_runs(args.quick, not args.no_sensitivity, only, not args.no_newton)
     for r in plan:
         r["threads"] = args.threads
         r["wait_policy"] = args.omp_wait_policy
         r["compare_fields"] = not args.quick  # field errors against the FEM VTU: full only
     if args.plan:
         for r in plan:
-            print("%-45s %s" % (r["id"], build_command(BY_KEY[r["problem"]], r, args.build_dir,
-                                                       runs_dir)[2]))
+            p = BY_KEY[r["problem"]]
+            note = ""
+            if r.get("solver") == "newton":
+                gb, basis = predict_newton_gb(p, per_thickness(p, r["dx"]), [])
+                if gb is not None:
+                    note = "   # predicted %.2g GB%s" % (
+                        gb, ": SKIPPED (> %g GB)" % args.newton_memory_gb
+                        if gb > args.newton_memory_gb else "")
+            print("%-45s %s%s" % (r["id"], build_command(p, r, args.build_dir, runs_dir)[2],
+                                  note))
         print("%d runs" % len(plan))
         return 0
 
@@ -1256,7 +1514,11 @@ def main(argv=None):
             "started": started, "git": git,
             "machine": machine_info(args.threads, args.build_dir),
             "omp_wait_policy": args.omp_wait_policy,
-            "quick": args.quick, "fem": fem_info}
+            "quick": args.quick, "fem": fem_info,
+            "newton": {"twins": not args.no_newton, "memory_budget_gb": args.newton_memory_gb,
+                       "memory_limit_gb": args.memory_limit_gb,
+                       "agreement_factor": NEWTON_AGREEMENT,
+                       "memory_measure": "peak resident set of each run (wait4 ru_maxrss)"}}
 
     if args.quick:
         out_path = runs_dir / "quick-results.json"
@@ -1264,7 +1526,10 @@ def main(argv=None):
     else:
         out_path = results_path
         previous = load_results(results_path) if only else None
-    kept = [r for r in (previous or {}).get("runs", []) if r["problem"] not in only]
+    # --only: the other problems' runs are kept; with --no-sensitivity the --only problems'
+    # sensitivity studies too (only their ladders are rerun)
+    kept = [r for r in (previous or {}).get("runs", []) if r["problem"] not in only or
+            (args.no_sensitivity and r["kind"] != "ladder")]
     for r in kept:  # a flag an earlier runner version left in its records
         if not isinstance(r.get("fields"), dict):
             r.pop("fields", None)
@@ -1280,19 +1545,50 @@ def main(argv=None):
 
     print("tlsph validation: %d runs, %d threads, runs in %s" % (len(plan), args.threads,
                                                                  rel(runs_dir)))
-    print("%-40s %9s %6s %8s %8s  %-13s %s" % ("run", "particles", "nb", "steps", "wall s",
-                                               "outcome", "error %"))
+    print("%-40s %9s %6s %8s %8s %7s  %-13s %s" % ("run", "particles", "nb", "steps",
+                                                    "wall s", "MB", "outcome", "error %"))
+    by_id = {}
     for r in plan:
         p = BY_KEY[r["problem"]]
-        rec = execute(p, r, args.build_dir, runs_dir, R, git, args.reuse, args.timeout)
+        rec = None
+        if r.get("solver") == "newton":
+            measured = [(x["per_thickness"], x["peak_rss_mb"] / 1024.0) for x in records
+                        if x["problem"] == p.key and x.get("solver") == "newton" and
+                        x.get("peak_rss_mb") and x.get("outcome") == "converged"]
+            gb, basis = predict_newton_gb(p, per_thickness(p, r["dx"]), measured)
+            if gb is not None and gb > args.newton_memory_gb:
+                rec = skipped_newton(p, r, gb, basis, args.newton_memory_gb, git)
+        if rec is None:
+            rec = execute(p, r, args.build_dir, runs_dir, R, git, args.reuse, args.timeout,
+                          args.memory_limit_gb)
+            if r.get("solver") == "newton":
+                rec["predicted_memory_gb"], rec["memory_prediction"] = gb, basis
+                twin = by_id.get(r["damped_twin"])
+                if twin is not None:
+                    rec["agreement"] = agreement(p, rec, twin)
+                else:
+                    rec["agreement"] = {"ok": False, "reason": "damped run %s not in this "
+                                        "invocation" % r["damped_twin"]}
         records.append(rec)
+        by_id[rec["id"]] = rec
         q = rec.get("qoi")
         err = q["errors"].get(q["primary"]) if q else None
-        print("%-40s %9s %6s %8s %8s  %-13s %s" % (
+        extra = ""
+        if rec.get("skipped"):
+            extra = "  " + rec["skipped"]
+        elif rec.get("agreement"):
+            a = rec["agreement"]
+            extra = "  vs damped: %s" % (
+                "max %.1e (limit %.0e) %s" % (a["max_checked"], a["limit"],
+                                              "ok" if a["ok"] else "FAIL")
+                if a.get("max_checked") is not None else a.get("reason", "FAIL"))
+        print("%-40s %9s %6s %8s %8s %7s  %-13s %s%s" % (
             rec["id"], rec.get("particles"),
             "%.1f" % rec["neighbours_mean"] if rec.get("neighbours_mean") else "-",
-            rec.get("steps"), "%.1f" % rec["wall_runner"], rec.get("outcome") or rec.get("rc"),
-            "%+.3f (%s)" % (err, q["primary"]) if err is not None else "-"), flush=True)
+            rec.get("steps"), "%.1f" % rec["wall_runner"],
+            "%.0f" % rec["peak_rss_mb"] if rec.get("peak_rss_mb") else "-",
+            rec.get("outcome") or rec.get("rc"),
+            "%+.3f (%s)" % (err, q["primary"]) if err is not None else "-", extra), flush=True)
         meta["elapsed_seconds"] = time.monotonic() - t_start
         save()
     meta["finished"] = time.strftime("%Y-%m-%d %H:%M:%S %Z")
@@ -1318,6 +1614,16 @@ def main(argv=None):
             print("%-36s %-26s %10s %10s  %s" % (rid, name, "%+.3f" % e if e is not None else "-",
                                                 "%.3f" % tol if tol is not None else "-",
                                                 verdict))
+        arows, aok = check_agreement(records)
+        if arows:
+            print()
+            print("%-36s %-26s %10s %10s  %s" % ("Newton twin", "value", "rel. diff",
+                                                 "limit", "verdict"))
+            for rid, name, d, lim, verdict in arows:
+                print("%-36s %-26s %10s %10s  %s" % (
+                    rid, name, "%+.1e" % d if d is not None else "-",
+                    "%.0e" % lim if lim is not None else "-", verdict))
+        ok = ok and aok
         print("validation check: %s" % ("PASSED" if ok else "FAILED"))
         status = 0 if ok else 1
     return status

@@ -14,9 +14,13 @@ inline volatile std::sig_atomic_t& stopSignal() {
   return signal;
 }
 
-inline bool stopRequested() { return stopSignal() != 0; }
+inline bool stopRequested() {
+  return stopSignal() != 0;
+}
 
-extern "C" inline void tlsphOnStopSignal(int signal) { stopSignal() = signal; }
+extern "C" inline void tlsphOnStopSignal(int signal) {
+  stopSignal() = signal;
+}
 
 inline void installStopHandlers() {
   stopSignal() = 0;
