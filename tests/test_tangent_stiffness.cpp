@@ -89,13 +89,6 @@ Scene<D> heldBlock(const Case& c, bool ghosts, std::mt19937& rng) {
   return scene;
 }
 
-std::vector<int> passiveOf(const std::vector<MirrorGhost>& ghosts) {
-  std::vector<int> g;
-  for (const auto& m : ghosts)
-    g.push_back(m.ghost);
-  return g;
-}
-
 // Dense K from the matrix-free product, from central differences of the net force, and from the
 // assembly (lower triangle mirrored).
 template <int D>
@@ -114,7 +107,7 @@ Matrices<D> matricesOf(Scene<D>& scene, std::mt19937& rng) {
   solver.reevaluate();
   DofMap<D> dofs(p, scene.mirrorGhosts);
   TangentStiffness<D> K(solver.reference(), scene.materials, p.material, p.volume,
-                        passiveOf(scene.mirrorGhosts), scene.hourglass(), dofs);
+                        scene.hourglass(), dofs);
   K.update(solver.forces().deformationGradient());
   const Index n = K.size();
   Matrices<D> m;
@@ -224,7 +217,7 @@ TEST(TangentStiffness, RejectsTheTextbookHourglassForm) {
   Solver<2> solver(scene);
   DofMap<2> dofs(scene.particles, scene.mirrorGhosts);
   EXPECT_THROW(TangentStiffness<2>(solver.reference(), scene.materials, scene.particles.material,
-                                   scene.particles.volume, {}, scene.hourglass(), dofs),
+                                   scene.particles.volume, scene.hourglass(), dofs),
                SetupError);
 }
 
@@ -262,8 +255,7 @@ alpha = 0
     Solver<3> solver(scene);
     DofMap<3> dofs(scene.particles, scene.mirrorGhosts);
     TangentStiffness<3> K(solver.reference(), scene.materials, scene.particles.material,
-                          scene.particles.volume, passiveOf(scene.mirrorGhosts), scene.hourglass(),
-                          dofs);
+                          scene.particles.volume, scene.hourglass(), dofs);
     std::mt19937 rng(5);
     const auto& free = dofs.freeParticles();
     for (int state = 0; state < 2; ++state) {

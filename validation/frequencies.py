@@ -88,36 +88,11 @@ PROBLEMS = {
 
 
 def timoshenko_bending(k):
-    """k-th (1 or 2) bending frequency [Hz] of the clamped-free Timoshenko beam: the root of
-    validation/references.py's frequency determinant nearest above 0.7 x Euler-Bernoulli."""
+    """k-th (1 or 2) bending frequency [Hz] of the clamped-free Timoshenko beam
+    (validation/references.py)."""
     A, I = BEAM_B**2, BEAM_B**4 / 12.0
-    if k == 1:
-        return R.timoshenko_frequency(E, NU, RHO, A, I, BEAM_L)
-    beta = {2: 4.6940911330}[k]
-    kGA = R.rectangle_shear_coefficient(NU) * E / (2 * (1 + NU)) * A
-    w_eb = 2 * math.pi * R.euler_bernoulli_frequency(E, I, RHO, A, BEAM_L, beta_l=beta)
-
-    def det(w):
-        return R._timoshenko_determinant(w, E, kGA, RHO, A, I, I, BEAM_L)
-
-    lo = 0.7 * w_eb
-    f_lo = det(lo)
-    while True:
-        hi = lo + 0.005 * w_eb
-        f_hi = det(hi)
-        if (f_lo < 0) != (f_hi < 0):
-            break
-        lo, f_lo = hi, f_hi
-        if lo > 1.2 * w_eb:
-            raise RuntimeError("no Timoshenko root near the second Euler-Bernoulli frequency")
-    for _ in range(60):
-        mid = 0.5 * (lo + hi)
-        f_mid = det(mid)
-        if (f_mid < 0) == (f_lo < 0):
-            lo, f_lo = mid, f_mid
-        else:
-            hi = mid
-    return 0.5 * (lo + hi) / (2 * math.pi)
+    beta = {1: 1.8751040687, 2: 4.6940911330}[k]
+    return R.timoshenko_frequency(E, NU, RHO, A, I, BEAM_L, beta_l=beta)
 
 
 def beam_theory():

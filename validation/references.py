@@ -30,15 +30,17 @@ def rectangle_shear_coefficient(nu):
     return 10.0 * (1.0 + nu) / (12.0 + 11.0 * nu)
 
 
-def timoshenko_frequency(E, nu, rho, A, I, L, kappa=None, rotary_inertia=True, G=None):
-    """First bending frequency [Hz] of a clamped-free Timoshenko beam, found by bisection on
-    the frequency determinant in a bracket around the Euler-Bernoulli value."""
+def timoshenko_frequency(E, nu, rho, A, I, L, kappa=None, rotary_inertia=True, G=None,
+                         beta_l=1.8751040687):
+    """Bending frequency [Hz] of a clamped-free Timoshenko beam, found by bisection on the
+    frequency determinant in a bracket around the Euler-Bernoulli value of the mode with
+    beta_l (1.8751040687: the first; 4.6940911330: the second)."""
     if kappa is None:
         kappa = rectangle_shear_coefficient(nu)
     if G is None:
         G = E / (2.0 * (1.0 + nu))
     I_rot = I if rotary_inertia else 0.0
-    w_eb = 2.0 * math.pi * euler_bernoulli_frequency(E, I, rho, A, L)
+    w_eb = 2.0 * math.pi * euler_bernoulli_frequency(E, I, rho, A, L, beta_l)
 
     def det(omega):
         # rotary inertia enters through rho*I_rot; the bending stiffness keeps I

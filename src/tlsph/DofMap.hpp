@@ -49,6 +49,13 @@ class DofMap {
   // Number of unknown particles (the system has D times as many scalar unknowns).
   Index size() const { return static_cast<Index>(freeParticles_.size()); }
   const std::vector<Index>& freeParticles() const { return freeParticles_; }
+  // The mirrored ghosts: particles that follow others and carry no strain energy of their own.
+  std::vector<Index> ghostParticles() const {
+    std::vector<Index> g;
+    for (const auto& m : ghosts_)
+      g.push_back(m.ghost);
+    return g;
+  }
   // Index among the unknowns of particle i, or -1 when it is not free.
   Index dofOf(Index i) const { return dofOf_[i]; }
 

@@ -54,13 +54,6 @@ class ShiftInvert {
   mutable bool notPositive_ = false;
 };
 
-std::vector<Index> mirrored(const std::vector<MirrorGhost>& ghosts) {
-  std::vector<Index> g;
-  for (const auto& m : ghosts)
-    g.push_back(m.ghost);
-  return g;
-}
-
 // The hourglass content (Diagnostics.hpp) of the displacement field u.
 template <int D>
 double hourglassContentOf(const ReferenceConfiguration<D>& ref, const std::vector<double>& volume,
@@ -103,7 +96,7 @@ ModalResult<D> computeModes(const Scene<D>& scene, Solver<D>& solver,
   const Index n = D * dofs.size();
   if (n == 0) throw SetupError("the scene has no free particles: nothing can vibrate");
   TangentStiffness<D> K(solver.reference(), scene.materials, p.material, p.volume,
-                        mirrored(scene.mirrorGhosts), scene.hourglass(), dofs);
+                        scene.hourglass(), dofs);
   K.update(solver.forces().deformationGradient());
   Eigen::VectorXd mass(n);
   for (Index d = 0; d < dofs.size(); ++d)

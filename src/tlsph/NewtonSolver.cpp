@@ -12,7 +12,7 @@ NewtonSolver<D>::NewtonSolver(Scene<D>& scene, Solver<D>& solver, const NewtonSe
       settings_(settings),
       dofs_(scene.particles, scene.mirrorGhosts),
       tangent_(solver.reference(), scene.materials, scene.particles.material,
-               scene.particles.volume, mirroredParticles(scene), scene.hourglass(), dofs_) {
+               scene.particles.volume, scene.hourglass(), dofs_) {
   statistics_.linearSolver = SparseCholesky::name();
   if (!tangent_.assemblyExact())
     statistics_.linearSolver = "conjugate gradients preconditioned by " + statistics_.linearSolver;
@@ -50,15 +50,6 @@ void NewtonSolver<D>::run(const std::function<bool()>& onStep) {
   }
 }
 
-template <int D>
-std::vector<Index> NewtonSolver<D>::mirroredParticles(const Scene<D>& scene) {
-  std::vector<Index> ghosts;
-  for (const auto& m : scene.mirrorGhosts)
-    ghosts.push_back(m.ghost);
-  return ghosts;
-}
-
-// Residual on the unknowns: the net force on each free particle.
 template <int D>
 void NewtonSolver<D>::residual(Eigen::VectorXd& r) const {
   const auto& free = dofs_.freeParticles();

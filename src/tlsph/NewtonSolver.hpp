@@ -65,8 +65,6 @@ class NewtonSolver {
   void run(const std::function<bool()>& onStep);
 
  private:
-  static std::vector<Index> mirroredParticles(const Scene<D>& scene);
-
   using Clock = std::chrono::steady_clock;
   static double seconds(Clock::time_point since) {
     return std::chrono::duration<double>(Clock::now() - since).count();

@@ -40,17 +40,17 @@ class TangentStiffness {
   using Modulus = Eigen::Matrix<double, DD, DD>;  // dP/dF, index i + D j of (i, j)
   using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 
-  // `passive`: the mirrored ghosts (no strain energy of their own).
+  // The mirrored ghosts of `dofs` carry no strain energy of their own.
   TangentStiffness(const ReferenceConfiguration<D>& ref, const std::vector<Material>& materials,
                    const std::vector<std::uint16_t>& materialOf, const std::vector<double>& volume,
-                   const std::vector<Index>& passive, const HourglassSettings& hourglass,
-                   const DofMap<D>& dofs)
+                   const HourglassSettings& hourglass, const DofMap<D>& dofs)
       : ref_(ref),
         materials_(materials),
         volume_(volume),
         hourglass_(hourglass),
         dofs_(dofs),
         n_(ref.particleCount()) {
+    const std::vector<Index> passive = dofs.ghostParticles();
     std::vector<std::uint8_t> isPassive(n_, 0);
     for (Index i : passive)
       isPassive.at(i) = 1;
