@@ -14,7 +14,7 @@ From the repository root (the build must exist: `bash scripts/setup.sh build`):
 `bash scripts/setup.sh validate` installs what is missing, builds and runs the full ladder.
 
 Each run is `build/tlsph run validation/scenes/<problem>.ini --output.directory=<runs>/<id>
---output.fields=none --no-progress [overrides]` with OMP_NUM_THREADS = --threads (default: all
+--output.fields=none --no-progress --overwrite [overrides]` with OMP_NUM_THREADS = --threads (default: all
 cores), one after the other. The runner reads the run's summary.json and probes.csv, extracts
 the quantity of interest, and compares it with the reference (validation/references.py, and
 the CalculiX solutions of validation/fem.py read from validation/fem/references.json: the
@@ -990,7 +990,7 @@ def build_command(problem, run, build_dir, runs_dir):
         output = ["--output.fields=none"]
     argv = [str(Path(build_dir) / "tlsph"), "run", str(scene),
             "--output.directory=" + str(outdir)] + output + [
-            "--no-progress", "--scene.dx=" + fmt(run["dx"])]
+            "--no-progress", "--overwrite", "--scene.dx=" + fmt(run["dx"])]
     for k, v in run["overrides"].items():
         argv.append("--%s=%s" % (k, v))
     env = ["OMP_NUM_THREADS=%d" % run["threads"]]

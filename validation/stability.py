@@ -31,7 +31,7 @@ bisection between the last stable and the first unstable value (if 0.2 is alread
 inverted material, or energy books off by more than [guard] energy_error, 5 % by default).
 
 Each run is `build/tlsph run validation/stability/<scene>.ini --output.directory=
-validation/runs/stability/<id> --output.fields=none --no-progress [overrides]` with
+validation/runs/stability/<id> --output.fields=none --no-progress --overwrite [overrides]` with
 OMP_NUM_THREADS = --threads (default: all cores), one after another. Recorded per run: exit
 status, outcome, wall time, steps, dt, the energy drift max_t |total(t) - total(0)| / max_t
 (kinetic + strain) from energies.csv (total is the balance of the energy books, so it
@@ -410,7 +410,7 @@ def argv_for(case, cfl, build_dir, check=False, extra=None, suffix=""):
     argv = [str(Path(build_dir) / "tlsph"), "check" if check else "run", rel(SCENES / case.scene)]
     if not check:
         argv += ["--output.directory=" + rel(RUNS / run_id(case, cfl, suffix)),
-                 "--output.fields=none", "--no-progress"]
+                 "--output.fields=none", "--no-progress", "--overwrite"]
     for k, v in case.overrides.items():
         argv.append("--%s=%s" % (k, v))
     if cfl is not None:

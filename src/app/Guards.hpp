@@ -107,6 +107,15 @@ inline bool booksFinite(const EnergyBalance& e) {
 
 }  // namespace guard_detail
 
+// What a guard remembers across checks, for checkpoint/restart (the last good state is the
+// state the run restarts from).
+struct GuardState {
+  EnergyBalance initial;
+  double total0 = 0.0;
+  double scale = 0.0;
+  double previousSpeed = 0.0;
+};
+
 template <int D>
 class RunGuard {
  public:
@@ -130,6 +139,19 @@ class RunGuard {
       for (Index i : load.particles)
         near_[i] |= kLoad;
     save(scanState(p, solver.forces().deformationGradient(), setup.ghost), initial_);
+  }
+
+  GuardState state() const { return {initial_, total0_, scale_, previousSpeed_}; }
+
+  // Continues a guard's memory in a restarted run: the present state (the checkpoint's, which
+  // passed its check) becomes the last good one.
+  void resume(const GuardState& g) {
+    initial_ = g.initial;
+    total0_ = g.total0;
+    scale_ = g.scale;
+    save(scanState(setup_.scene.particles, solver_.forces().deformationGradient(), setup_.ghost),
+         solver_.energyBalance());
+    previousSpeed_ = g.previousSpeed;
   }
 
   // At a check: nothing if the state is healthy (it becomes the last good one), else the

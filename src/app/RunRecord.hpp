@@ -45,6 +45,8 @@ inline const char* outcomeName(RunOutcome o) {
       return "unstable";
     case RunOutcome::Interrupted:
       return "interrupted";
+    case RunOutcome::OutputFailed:
+      return "output-failed";
   }
   return "";
 }
@@ -107,6 +109,9 @@ void writeRunRecord(const std::filesystem::path& file, const SceneSetup<D>& setu
   field("external_work", jsonNumber(s.energy.externalWork));
   field("damped", jsonNumber(s.energy.damped));
   field("pvd", jsonText(s.pvd.string()));
+  // Checkpoint/restart: the last checkpoint this run wrote, and where a restarted run began.
+  field("checkpoint", jsonText(s.checkpoint.string()));
+  field("restarted_at_step", s.restartedAtStep >= 0 ? std::to_string(s.restartedAtStep) : "null");
   field("energies", jsonText(s.energies.string()));
   if (s.instability) {
     // What the stability guard found (app/Guards.hpp).

@@ -10,8 +10,11 @@
 #include <optional>
 #include <ostream>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 
+#include "app/Checkpoint.hpp"
+#include "app/CheckpointSchedule.hpp"
 #include "app/Frames.hpp"
 #include "app/Guards.hpp"
 #include "app/StopRequest.hpp"
@@ -24,11 +27,13 @@
 namespace tlsph {
 
 struct RunOptions {
-  bool progress = false;  // a live progress line (on a terminal only)
-  std::string command;    // recorded in the CSV preamble, to reproduce the run
+  bool progress = false;    // a live progress line (on a terminal only)
+  std::string command;      // recorded in the CSV preamble, to reproduce the run
+  CheckpointOrigin origin;  // recorded in each checkpoint: the scene and the program
 };
 
-enum class RunOutcome { Finished, Converged, NotConverged, Unstable, Interrupted };
+// OutputFailed: a file could not be written (disk full, no permission): the run stops.
+enum class RunOutcome { Finished, Converged, NotConverged, Unstable, Interrupted, OutputFailed };
 
 struct RunSummary {
   RunOutcome outcome = RunOutcome::Finished;
@@ -45,6 +50,9 @@ struct RunSummary {
   std::string message;
   std::optional<Instability> instability;  // set when the outcome is Unstable
   std::optional<NewtonStatistics> newton;  // set for a Newton static run
+  std::filesystem::path checkpoint;        // the last checkpoint this run wrote
+  long checkpointsWritten = 0;
+  long restartedAtStep = -1;  // the checkpoint's step when the run was restarted
 };
 
 template <int D>
@@ -95,14 +103,23 @@ std::vector<double> probeRow(const SceneSetup<D>& setup, const Solver<D>& solver
   return row;
 }
 
-// onStart sees the solver once it is set up (neighbours, dt), before the first step.
+// A file of the run's output could not be written; the run stops (RunOutcome::OutputFailed).
+class OutputWriteFailure : public std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// onStart sees the solver once it is set up (neighbours, dt), before the first step. With
+// `resume`, the run continues from that checkpoint (its output directory holds the run's output
+// up to there) and ends bit for bit where the uninterrupted run would have.
 template <int D, class OnStart>
-RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStart&& onStart) {
+RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStart&& onStart,
+                         const Checkpoint<D>* resume = nullptr) {
   namespace fs = std::filesystem;
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
   Solver<D> solver(setup.scene, setup.solver);
   onStart(solver);
+  if (resume) solver.restore(resume->solver);
   const auto& p = setup.scene.particles;
   const RunSettings& run = setup.run;
   const OutputSettings& out = setup.output;
@@ -166,22 +183,93 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
     if (probes) probes->append(probeRow(setup, solver));
     if (reactions) reactions->append(reactionRow());
   };
+  // Every write goes through here: a failure stops the run as OutputFailed.
+  auto writing = [&](auto&& write) {
+    try {
+      write();
+    } catch (const OutputWriteFailure&) {
+      throw;
+    } catch (const std::exception& e) {
+      throw OutputWriteFailure(e.what());
+    }
+  };
+  auto flushSeries = [&] {
+    writing([&] {
+      energies.flush();
+      if (probes) probes->flush();
+      if (reactions) reactions->flush();
+    });
+  };
   long lastFrameStep = -1;
+  double nextFrameTime = out.everyTime;
   auto writeFrame = [&] {
-    if (vtu && lastFrameStep != solver.stepCount()) vtu->write(makeFrame(setup, solver));
+    if (vtu && lastFrameStep != solver.stepCount())
+      writing([&] { vtu->write(makeFrame(setup, solver)); });
     lastFrameStep = solver.stepCount();
-    energies.flush();
-    if (probes) probes->flush();
-    if (reactions) reactions->flush();
+    flushSeries();
   };
 
   RunSummary summary;
   summary.timeStep = solver.timeStep();
   summary.stableStep = solver.stableStepRule();
-  recordSeries();
-  writeFrame();
   RunGuard<D> guard(setup, solver);  // the stability guards (Guards.hpp)
-  // What every run reports at its end (steps, residual and energy books: the caller).
+  if (resume) {
+    // The output as it was at the checkpoint: later rows and frames (written before the stop)
+    // are dropped, so the continuation has neither duplicates nor gaps.
+    const OutputProgress& o = resume->output;
+    energies.resume(o.energyRows);
+    if (probes) probes->resume(o.probeRows);
+    if (reactions) reactions->resume(o.reactionRows);
+    if (vtu) vtu->resume(o.frames);
+    lastFrameStep = o.lastFrameStep;
+    nextFrameTime = o.nextFrameTime;
+    guard.resume(resume->guard);
+    summary.restartedAtStep = resume->solver.steps;
+  }
+
+  CheckpointSchedule schedule(dir, setup.name, setup.checkpoint);
+  // The series are flushed first, so that the files hold every row the checkpoint counts.
+  auto saveCheckpoint = [&](const NewtonSolver<D>* newton) {
+    flushSeries();
+    Checkpoint<D> c;
+    c.origin = options.origin;
+    c.solver = solver.state();
+    c.guard = guard.state();
+    if (newton) c.newton = newton->state();
+    c.output.nextFrameTime = nextFrameTime;
+    c.output.lastFrameStep = lastFrameStep;
+    c.output.energyRows = energies.rowCount();
+    c.output.probeRows = probes ? probes->rowCount() : 0;
+    c.output.reactionRows = reactions ? reactions->rowCount() : 0;
+    if (vtu) c.output.frames = vtu->frames();
+    const fs::path file = schedule.fileFor(solver.stepCount());
+    writing([&] { writeCheckpoint(file, c); });
+    schedule.written();
+    summary.checkpoint = file;
+    ++summary.checkpointsWritten;
+  };
+  // After a failed write: one attempt at a checkpoint, and a message saying what is left.
+  auto outputFailed = [&](const OutputWriteFailure& failure, const NewtonSolver<D>* newton) {
+    summary.outcome = RunOutcome::OutputFailed;
+    std::ostringstream m;
+    m << "writing the output failed at step " << solver.stepCount() << ", t = " << solver.time()
+      << " s: " << failure.what() << " (disk full? no permission?). The run stopped; ";
+    const fs::path previous = summary.checkpoint;
+    try {
+      saveCheckpoint(newton);
+      m << "a checkpoint of this step was written to " << summary.checkpoint.string()
+        << ": make room, then continue with --restart=" << summary.checkpoint.string();
+    } catch (const OutputWriteFailure& again) {
+      m << "no checkpoint could be written either (" << again.what() << ")";
+      if (!previous.empty())
+        m << "; the last one is " << previous.string() << " (--restart=" << previous.string()
+          << ")";
+    }
+    summary.message = m.str();
+  };
+
+  // What every run reports at its end.
+  bool stateRecorded = false;  // an unstable run reports the failing state, recorded before
   auto finish = [&] {
     summary.wallSeconds = std::chrono::duration<double>(Clock::now() - start).count();
     if (vtu) summary.pvd = vtu->pvdPath();
@@ -193,22 +281,44 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
       R.head<D>() = solver.reaction(r);
       summary.finalReactions.emplace_back(rules[r].name, R);
     }
+    if (!stateRecorded) {
+      summary.steps = solver.stepCount();
+      summary.time = solver.time();
+      summary.residual = solver.residualRatio();
+      summary.energy = solver.energyBalance();
+    }
     return summary;
   };
   auto interruptedMessage = [&] {
     std::ostringstream m;
     m << "stopped by signal " << int(stopSignal()) << " at step " << solver.stepCount()
       << ", t = " << solver.time() << " s: the output holds the state at that step";
+    if (!summary.checkpoint.empty())
+      m << "; continue with --restart=" << summary.checkpoint.string();
     return m.str();
   };
+
   if (run.newtonStatic()) {
     // Load steps to equilibrium: one series row and one frame per converged step.
     NewtonSolver<D> newton(setup.scene, solver, run.newton);
+    if (resume) {
+      if (!resume->newton)
+        throw CheckpointError("the checkpoint holds no Newton state (written by a damped run)");
+      newton.resume(*resume->newton);
+    }
     try {
+      if (!resume) {
+        recordSeries();
+        writeFrame();
+      }
       newton.run([&] {
         recordSeries();
         writeFrame();
-        if (stopRequested()) return false;
+        if (stopRequested()) {
+          saveCheckpoint(&newton);
+          return false;
+        }
+        if (schedule.due(newton.statistics().loadSteps)) saveCheckpoint(&newton);
         if (options.progress) {
           const auto& st = newton.statistics();
           std::fprintf(stderr,
@@ -225,100 +335,129 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
     } catch (const NewtonFailure& failure) {
       summary.outcome = RunOutcome::NotConverged;
       summary.message = failure.what();
-      recordSeries();
-      writeFrame();
+      try {
+        recordSeries();
+        writeFrame();
+      } catch (const OutputWriteFailure& f) {
+        outputFailed(f, nullptr);
+      }
+    } catch (const OutputWriteFailure& f) {
+      outputFailed(f, &newton);
     }
     if (options.progress) std::fprintf(stderr, "\r\033[K");
     summary.newton = newton.statistics();
-    summary.steps = solver.stepCount();
-    summary.time = solver.time();
-    summary.residual = solver.residualRatio();
-    summary.energy = solver.energyBalance();
     return finish();
   }
-  double nextFrameTime = out.everyTime;
+
   auto lastProgress = Clock::now();
   // The CSV series reach the disk at least every flushSeconds of wall time, so a run that is
   // killed leaves its series up to then (frames flush them too).
   auto lastFlush = Clock::now();
   const auto flushInterval = std::chrono::duration<double>(out.flushSeconds);
   const double endTime = run.endTime * (1.0 - 1e-12);
-  while (true) {
-    if (solver.time() >= endTime) {
-      summary.outcome = run.quasiStatic ? RunOutcome::NotConverged : RunOutcome::Finished;
-      break;
-    }
-    if (run.maxSteps > 0 && solver.stepCount() >= run.maxSteps) {
-      summary.outcome = run.quasiStatic ? RunOutcome::NotConverged : RunOutcome::Finished;
-      summary.message =
-          "stopped at the step limit [time] max_steps = " + std::to_string(run.maxSteps);
-      break;
-    }
-    if (stopRequested()) {
-      summary.outcome = RunOutcome::Interrupted;
-      summary.message = interruptedMessage();
-      break;
-    }
-    solver.step();
-    const long step = solver.stepCount();
-    if (step % run.checkEvery == 0) {
-      summary.instability = guard.check();
-      if (summary.instability) {
-        summary.outcome = RunOutcome::Unstable;
-        break;
-      }
-      if (run.quasiStatic && solver.time() >= solver.rampEnd() &&
-          solver.residualRatio() < run.tolerance) {
-        summary.outcome = RunOutcome::Converged;
-        break;
-      }
-    }
-    if (step % out.seriesEverySteps == 0) {
+  try {
+    if (!resume) {
       recordSeries();
-      if (Clock::now() - lastFlush > flushInterval) {
-        energies.flush();
-        if (probes) probes->flush();
-        if (reactions) reactions->flush();
-        lastFlush = Clock::now();
+      writeFrame();
+    }
+    while (true) {
+      if (solver.time() >= endTime) {
+        summary.outcome = run.quasiStatic ? RunOutcome::NotConverged : RunOutcome::Finished;
+        break;
+      }
+      if (run.maxSteps > 0 && solver.stepCount() >= run.maxSteps) {
+        summary.outcome = run.quasiStatic ? RunOutcome::NotConverged : RunOutcome::Finished;
+        summary.message =
+            "stopped at the step limit [time] max_steps = " + std::to_string(run.maxSteps);
+        break;
+      }
+      if (stopRequested()) {
+        // A checkpoint of a healthy state only: the guards look at it first.
+        summary.instability = guard.check();
+        if (summary.instability) {
+          summary.outcome = RunOutcome::Unstable;
+          break;
+        }
+        saveCheckpoint(nullptr);
+        summary.outcome = RunOutcome::Interrupted;
+        summary.message = interruptedMessage();
+        break;
+      }
+      solver.step();
+      const long step = solver.stepCount();
+      const bool checkStep = step % run.checkEvery == 0;
+      if (checkStep) {
+        summary.instability = guard.check();
+        if (summary.instability) {
+          summary.outcome = RunOutcome::Unstable;
+          break;
+        }
+        if (run.quasiStatic && solver.time() >= solver.rampEnd() &&
+            solver.residualRatio() < run.tolerance) {
+          summary.outcome = RunOutcome::Converged;
+          break;
+        }
+      }
+      if (step % out.seriesEverySteps == 0) {
+        recordSeries();
+        if (Clock::now() - lastFlush > flushInterval) {
+          flushSeries();
+          lastFlush = Clock::now();
+        }
+      }
+      const bool frameDue = out.everySteps > 0 ? step % out.everySteps == 0
+                                               : solver.time() >= nextFrameTime * (1.0 - 1e-12);
+      if (frameDue) {
+        writeFrame();
+        while (out.everyTime > 0 && nextFrameTime <= solver.time() * (1.0 + 1e-12))
+          nextFrameTime += out.everyTime;
+      }
+      // A checkpoint holds a state the guards have passed: a good one to continue from.
+      if (schedule.due(step)) {
+        if (!checkStep && (summary.instability = guard.check())) {
+          summary.outcome = RunOutcome::Unstable;
+          break;
+        }
+        saveCheckpoint(nullptr);
+      }
+      if (options.progress && Clock::now() - lastProgress > std::chrono::milliseconds(500)) {
+        lastProgress = Clock::now();
+        const double wall = std::chrono::duration<double>(lastProgress - start).count();
+        const EnergyBalance e = solver.energyBalance();
+        std::fprintf(stderr, "\r\033[Kstep %ld  t = %.4g s of %.4g  dt = %.3g  ", step,
+                     solver.time(), run.endTime, solver.timeStep());
+        if (run.quasiStatic)
+          std::fprintf(stderr, "residual %.3g (target %.3g)  ", solver.residualRatio(),
+                       run.tolerance);
+        const double eta = wall * (run.endTime - solver.time()) / std::max(solver.time(), 1e-300);
+        std::fprintf(stderr, "ETA %s%.0f s  E_kin %.3g  E_strain %.3g",
+                     run.quasiStatic ? "<= " : "", eta, e.kinetic, e.strain);
+        std::fflush(stderr);
       }
     }
-    const bool frameDue = out.everySteps > 0 ? step % out.everySteps == 0
-                                             : solver.time() >= nextFrameTime * (1.0 - 1e-12);
-    if (frameDue) {
+    if (options.progress) std::fprintf(stderr, "\r\033[K");
+    if (summary.outcome != RunOutcome::Unstable) {
+      recordSeries();
       writeFrame();
-      while (out.everyTime > 0 && nextFrameTime <= solver.time() * (1.0 + 1e-12))
-        nextFrameTime += out.everyTime;
+    } else {
+      // The failing state's numbers for the record, then its frames (which leave the solver
+      // in the last good state).
+      flushSeries();
+      summary.steps = solver.stepCount();
+      summary.time = solver.time();
+      summary.residual = solver.residualRatio();
+      summary.energy = solver.energyBalance();
+      stateRecorded = true;
+      try {
+        guard.writeFrames(*summary.instability);
+      } catch (const std::exception& e) {
+        summary.message =
+            std::string("the frames of the instability could not be written: ") + e.what();
+      }
     }
-    if (options.progress && Clock::now() - lastProgress > std::chrono::milliseconds(500)) {
-      lastProgress = Clock::now();
-      const double wall = std::chrono::duration<double>(lastProgress - start).count();
-      const EnergyBalance e = solver.energyBalance();
-      std::fprintf(stderr, "\r\033[Kstep %ld  t = %.4g s of %.4g  dt = %.3g  ", step, solver.time(),
-                   run.endTime, solver.timeStep());
-      if (run.quasiStatic)
-        std::fprintf(stderr, "residual %.3g (target %.3g)  ", solver.residualRatio(),
-                     run.tolerance);
-      const double eta = wall * (run.endTime - solver.time()) / std::max(solver.time(), 1e-300);
-      std::fprintf(stderr, "ETA %s%.0f s  E_kin %.3g  E_strain %.3g", run.quasiStatic ? "<= " : "",
-                   eta, e.kinetic, e.strain);
-      std::fflush(stderr);
-    }
-  }
-  if (options.progress) std::fprintf(stderr, "\r\033[K");
-
-  summary.steps = solver.stepCount();
-  summary.time = solver.time();
-  summary.residual = solver.residualRatio();
-  if (summary.outcome != RunOutcome::Unstable) {
-    recordSeries();
-    writeFrame();
-    summary.energy = solver.energyBalance();
-  } else {
-    energies.flush();
-    if (probes) probes->flush();
-    if (reactions) reactions->flush();
-    summary.energy = solver.energyBalance();  // the failing state's books
-    guard.writeFrames(*summary.instability);  // leaves the solver in the last good state
+  } catch (const OutputWriteFailure& failure) {
+    if (options.progress) std::fprintf(stderr, "\r\033[K");
+    outputFailed(failure, nullptr);
   }
   return finish();
 }

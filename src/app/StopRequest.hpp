@@ -1,6 +1,6 @@
-// SIGINT and SIGTERM ask a run to stop: the run loop ends its step, writes the series, a frame
-// and summary.json, and `tlsph` exits with 128 + the signal number (130, 143). The handlers are
-// one-shot (SA_RESETHAND): a second signal ends the process at once.
+// SIGINT and SIGTERM ask a run to stop: the run loop ends its step, writes a checkpoint, the
+// series, a frame and summary.json, and `tlsph` exits with 128 + the signal number (130, 143). The
+// handlers are one-shot (SA_RESETHAND): a second signal ends the process at once.
 #pragma once
 
 #include <csignal>
@@ -30,6 +30,9 @@ inline void installStopHandlers() {
   action.sa_flags = SA_RESETHAND;
   sigaction(SIGINT, &action, nullptr);
   sigaction(SIGTERM, &action, nullptr);
+  // A file grown past the size limit (ulimit -f) is a failed write the run reports, with a
+  // checkpoint attempt, rather than a signal that kills it.
+  std::signal(SIGXFSZ, SIG_IGN);
 }
 
 }  // namespace tlsph

@@ -6,12 +6,17 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <fstream>
 #include <iostream>
+#include <sstream>
 #include <string>
 #include <vector>
 
+#include "app/Checkpoint.hpp"
+#include "app/CheckpointSchedule.hpp"
 #include "app/CompareCommand.hpp"
 #include "app/ModesCommand.hpp"
+#include "app/OutputDirectory.hpp"
 #include "app/RunRecord.hpp"
 #include "app/RunSimulation.hpp"
 #include "scene/Config.hpp"
@@ -46,16 +51,32 @@ The scene format is documented in docs/scene-format.md.
 run options:
   --progress / --no-progress   live progress line (default: on when stderr is a terminal
                                and CI is not set)
+  --overwrite                  replace the output of an earlier run in the output directory
+                               (without it such a directory is refused)
+  --restart=CHECKPOINT         continue the run from a checkpoint (a file written under
+                               OUTPUT/checkpoints/, or 'latest'); the scene must be the same
+                               ([checkpoint] settings may differ) and the result is bit for
+                               bit that of the uninterrupted run (same thread count)
 
 exit status: 0 finished (or a static run converged), 1 bad input or set-up, 3 a static
 run did not converge, 4 the run went unstable (a [guard] check failed: the message names
 step, particle, quantity and likely cause; NAME_last_good.vtu and NAME_failed.vtu are
-written), 5 (modes) zero-energy modes other than rigid-body motions, 130 / 143 stopped by
-SIGINT (Ctrl-C) / SIGTERM: the series, a frame and summary.json hold the state at the step it
-stopped (a second signal ends the program at once).
+written), 5 (modes) zero-energy modes other than rigid-body motions, 6 an output file could
+not be written (disk full, no permission: the message says which, and where the checkpoint
+written on the way out is), 130 / 143 stopped by SIGINT (Ctrl-C) / SIGTERM: a checkpoint,
+the series, a frame and summary.json hold the state at the step it stopped (a second signal
+ends the program at once).
 )";
 
 using namespace tlsph;
+namespace fs = std::filesystem;
+
+struct RunFlags {
+  bool overwrite = false;
+  std::string restart;  // checkpoint file, "latest", or empty
+  std::string sceneFile;
+  std::vector<std::string> overrides;
+};
 
 template <int D>
 void printSetup(const SceneSetup<D>& setup, const Solver<D>& solver) {
@@ -142,6 +163,26 @@ void printSetup(const SceneSetup<D>& setup, const Solver<D>& solver) {
       std::cout << " " << f;
     std::cout << "\n";
   }
+  const OutputEstimate e = estimateOutput(setup, solver.timeStep());
+  std::cout << "output size  at most " << byteText(e.total()) << ": " << e.frames << " frames of "
+            << byteText(e.frameBytes) << " (uncompressed), " << e.seriesRows << " series rows ("
+            << byteText(e.seriesBytes) << "), " << e.checkpointsKept << " checkpoint(s) of "
+            << byteText(e.checkpointBytes) << " kept";
+  std::error_code noSpace;
+  fs::path existing = setup.output.directory;
+  while (!existing.empty() && !fs::exists(existing, noSpace))
+    existing = existing.parent_path();
+  const auto space = fs::space(existing.empty() ? fs::path(".") : existing, noSpace);
+  if (!noSpace) std::cout << "; " << byteText(double(space.available)) << " free there";
+  std::cout << "\n";
+  const CheckpointSettings& ck = setup.checkpoint;
+  std::cout << "checkpoints  ";
+  if (ck.everySteps > 0)
+    std::cout << "every " << ck.everySteps << (setup.run.newtonStatic() ? " load" : "")
+              << " steps, ";
+  if (ck.everySeconds > 0) std::cout << "every " << ck.everySeconds << " s of wall time, ";
+  std::cout << "on SIGINT/SIGTERM and on a failed write; the newest " << ck.keep << " kept in "
+            << setup.output.directory << "/checkpoints/\n";
 }
 
 // Warnings only the solver's set-up can give (added to the scene's, for summary.json).
@@ -164,7 +205,8 @@ void addSolverWarnings(SceneSetup<D>& setup, const Solver<D>& solver, const std:
 }
 
 template <int D>
-int runOrCheck(const Config& config, bool run, bool progress, const std::string& command) {
+int runOrCheck(const Config& config, bool run, bool progress, const std::string& command,
+               const RunFlags& flags) {
   SceneSetup<D> setup = buildScene<D>(config);
   for (const auto& warning : setup.warnings)
     std::cerr << command << ": warning: " << warning << "\n";
@@ -175,23 +217,67 @@ int runOrCheck(const Config& config, bool run, bool progress, const std::string&
     printSetup(setup, solver);
     return 0;
   }
-  RunOptions options;
-  options.progress = progress;
-  options.command = command;
-  installStopHandlers();
-  NeighbourStats neighbours;
-  const RunSummary s = runSimulation(setup, options, [&](const Solver<D>& solver) {
-    addSolverWarnings(setup, solver, command);
-    printSetup(setup, solver);
-    neighbours = neighbourStats(solver, setup.scene.particles.size());
-  });
   int threads = 1;
 #ifdef _OPENMP
   threads = omp_get_max_threads();
 #endif
+  RunOptions options;
+  options.progress = progress;
+  options.command = command;
+  options.origin.version = kVersion;
+  options.origin.sceneFile = flags.sceneFile;
+  {
+    std::ifstream in(flags.sceneFile, std::ios::binary);
+    std::stringstream text;
+    text << in.rdbuf();
+    options.origin.sceneText = text.str();
+  }
+  options.origin.overrides = flags.overrides;
+  options.origin.settings = config.settings();
+  options.origin.threads = threads;
+
+  std::optional<Checkpoint<D>> resume;
+  if (!flags.restart.empty()) {
+    const fs::path file = flags.restart == "latest"
+                              ? CheckpointSchedule::latest(setup.output.directory, setup.name)
+                              : fs::path(flags.restart);
+    const CheckpointReader reader(file);
+    const std::string why =
+        checkpointMismatch(readCheckpointOrigin(reader), kVersion, options.origin.settings);
+    if (!why.empty())
+      throw CheckpointError("cannot restart from checkpoint " + file.string() + ": " + why);
+    resume = readCheckpoint<D>(reader);
+    if (resume->origin.threads != threads)
+      std::cerr << command << ": warning: the checkpoint was written by a run on "
+                << resume->origin.threads << " thread(s), this one has " << threads
+                << ": it continues the run, but bit-for-bit equality with an uninterrupted run "
+                   "needs the same count (OMP_NUM_THREADS="
+                << resume->origin.threads << ")\n";
+    std::cout << "restart      from " << file.string() << " (step " << resume->solver.steps
+              << ", t = " << resume->solver.time << " s)\n";
+  }
+  prepareOutputDirectory(setup.output.directory, setup.name, flags.overwrite, resume.has_value());
+
+  installStopHandlers();
+  NeighbourStats neighbours;
+  const RunSummary s = runSimulation(
+      setup, options,
+      [&](const Solver<D>& solver) {
+        addSolverWarnings(setup, solver, command);
+        printSetup(setup, solver);
+        if (!resume)
+          checkFreeSpace(setup.output.directory, estimateOutput(setup, solver.timeStep()));
+        neighbours = neighbourStats(solver, setup.scene.particles.size());
+      },
+      resume ? &*resume : nullptr);
   const std::filesystem::path record =
       std::filesystem::path(setup.output.directory) / "summary.json";
-  writeRunRecord(record, setup, neighbours, s, threads, command, kVersion);
+  try {
+    writeRunRecord(record, setup, neighbours, s, threads, command, kVersion);
+  } catch (const std::exception& e) {
+    std::cerr << "tlsph: cannot write " << record.string() << ": " << e.what() << "\n";
+    if (s.outcome != RunOutcome::OutputFailed) return 6;
+  }
   if (s.newton) {
     const NewtonStatistics& n = *s.newton;
     std::cout << "\nNewton       " << n.loadSteps << " load steps, " << n.iterations
@@ -220,7 +306,10 @@ int runOrCheck(const Config& config, bool run, bool progress, const std::string&
               << s.instability->lastGoodStep << ", t = " << s.instability->lastGoodTime << " s)\n";
   }
   std::cout << "wrote        " << record.string() << "\n";
-  if (!s.message.empty()) std::cout << s.message << "\n";
+  if (!s.checkpoint.empty() && s.outcome != RunOutcome::OutputFailed)
+    std::cout << "checkpoint   " << s.checkpoint.string() << " (" << s.checkpointsWritten
+              << " written by this run)\n";
+  if (!s.message.empty() && s.outcome != RunOutcome::OutputFailed) std::cout << s.message << "\n";
   switch (s.outcome) {
     case RunOutcome::Finished:
       std::cout << "finished\n";
@@ -239,6 +328,10 @@ int runOrCheck(const Config& config, bool run, bool progress, const std::string&
     case RunOutcome::Interrupted:
       std::cout << "interrupted\n";
       return 128 + int(stopSignal());
+    case RunOutcome::OutputFailed:
+      std::cout.flush();
+      std::cerr << "tlsph: " << s.message << "\n";
+      return 6;
     case RunOutcome::Unstable: {
       // tlsph: unstable at step N, t = T s: <quantity and value> at particle I (X = ...):
       //   likely <cause>
@@ -282,9 +375,29 @@ int main(int argc, char** argv) {
   for (const auto& a : args)
     command += " " + a;
   ModesOptions modes;
+  RunFlags flags;
+  flags.sceneFile = args[1];
   for (std::size_t k = 2; k < args.size(); ++k) {
     if (args[k] == "--progress") {
       progress = true;
+    } else if (verb == "run" && args[k] == "--overwrite") {
+      flags.overwrite = true;
+    } else if (verb == "run" && (args[k].rfind("--restart=", 0) == 0 || args[k] == "--restart")) {
+      std::string value;
+      if (args[k] == "--restart") {
+        if (k + 1 == args.size()) {
+          std::cerr << "tlsph: run: --restart expects a checkpoint file or 'latest'\n";
+          return 1;
+        }
+        value = args[++k];
+      } else {
+        value = args[k].substr(10);
+      }
+      if (value.empty()) {
+        std::cerr << "tlsph: run: --restart expects a checkpoint file or 'latest'\n";
+        return 1;
+      }
+      flags.restart = value;
     } else if (args[k] == "--no-progress") {
       progress = false;
     } else if (verb == "modes" && args[k].rfind("--count=", 0) == 0) {
@@ -308,6 +421,7 @@ int main(int argc, char** argv) {
       overrides.push_back(args[k]);
     }
   }
+  flags.overrides = overrides;
   try {
     const Config config = Config::read(args[1], overrides);
     const int d = sceneDimension(config);
@@ -321,8 +435,8 @@ int main(int argc, char** argv) {
       SceneSetup<3> setup = buildScene<3>(config);
       return runModes<3>(setup, modes);
     }
-    return d == 2 ? runOrCheck<2>(config, verb == "run", progress, command)
-                  : runOrCheck<3>(config, verb == "run", progress, command);
+    return d == 2 ? runOrCheck<2>(config, verb == "run", progress, command, flags)
+                  : runOrCheck<3>(config, verb == "run", progress, command, flags);
   } catch (const InputError& e) {
     std::cerr << "tlsph: " << e.what() << "\n";
   } catch (const SetupError& e) {

@@ -34,17 +34,60 @@ void CsvSeries::append(const std::vector<double>& row) {
   ++rowCount_;
 }
 
-void CsvSeries::flush() {
-  std::string head;
-  for (const auto& line : preamble_) {
-    head += "# ";
-    for (const char c : line) {
-      if (c == '\r') continue;
-      head += c;
-      if (c == '\n') head += "# ";
+void CsvSeries::resume(std::size_t rows) {
+  std::ifstream in(file_, std::ios::binary);
+  if (!in)
+    throw std::runtime_error("cannot continue CSV series " + file_.string() +
+                             ": the file is missing or unreadable");
+  std::string header;
+  for (std::size_t c = 0; c < columns_.size(); ++c)
+    header += (c > 0 ? "," : "") + columns_[c];
+  std::string head, kept, line;
+  bool headerSeen = false;
+  std::size_t count = 0;
+  while (count < rows && std::getline(in, line)) {
+    if (!headerSeen) {
+      if (!line.empty() && line[0] == '#') {
+        head += line + '\n';
+        continue;
+      }
+      if (line != header)
+        throw std::runtime_error("cannot continue CSV series " + file_.string() +
+                                 ": its header is '" + line + "', this run writes '" + header +
+                                 "'");
+      headerSeen = true;
+      continue;
     }
-    head += '\n';
+    kept += line + '\n';
+    ++count;
   }
+  if (!headerSeen && rows == 0) {
+    // Nothing to keep: a fresh file with this run's preamble.
+    rows_.clear();
+    rowCount_ = 0;
+    return;
+  }
+  if (count < rows)
+    throw std::runtime_error("cannot continue CSV series " + file_.string() + ": it holds " +
+                             std::to_string(count) + " rows, the checkpoint expects " +
+                             std::to_string(rows));
+  resumedHead_ = head;
+  rows_ = kept;
+  rowCount_ = count;
+}
+
+void CsvSeries::flush() {
+  std::string head = resumedHead_;
+  if (head.empty())
+    for (const auto& line : preamble_) {
+      head += "# ";
+      for (const char c : line) {
+        if (c == '\r') continue;
+        head += c;
+        if (c == '\n') head += "# ";
+      }
+      head += '\n';
+    }
   for (std::size_t c = 0; c < columns_.size(); ++c) {
     if (c > 0) head += ',';
     head += columns_[c];

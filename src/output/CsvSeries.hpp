@@ -20,6 +20,12 @@ class CsvSeries {
   // start new comment lines.
   void setPreamble(std::vector<std::string> lines);
 
+  // Continues the series of an interrupted run from its file: keeps the file's comment lines and
+  // its first `rows` rows (those before the checkpoint; later ones are dropped, so the restarted
+  // run appends without duplicates or gaps). Throws std::runtime_error naming the file if it is
+  // missing, its header differs from the columns, or it holds fewer rows.
+  void resume(std::size_t rows);
+
   // Throws std::invalid_argument if row.size() != column count.
   void append(const std::vector<double>& row);
 
@@ -35,7 +41,8 @@ class CsvSeries {
   std::filesystem::path file_;
   std::vector<std::string> columns_;
   std::vector<std::string> preamble_;
-  std::string rows_;  // formatted once on append, so repeated flushes only copy text
+  std::string resumedHead_;  // comment lines read back by resume(), written instead of preamble_
+  std::string rows_;         // formatted once on append, so repeated flushes only copy text
   std::size_t rowCount_ = 0;
 };
 

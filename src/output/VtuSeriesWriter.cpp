@@ -23,6 +23,17 @@ VtuSeriesWriter::VtuSeriesWriter(std::filesystem::path directory, std::string ba
   pvdPath_ = directory_ / (baseName_ + ".pvd");
 }
 
+void VtuSeriesWriter::resume(const std::vector<PvdEntry>& frames) {
+  entries_ = frames;
+  writePvdFile(pvdPath_, entries_);
+  std::error_code ignored;
+  for (std::size_t k = entries_.size();; ++k) {
+    char counter[32];
+    std::snprintf(counter, sizeof counter, "_%06zu.vtu", k);
+    if (!std::filesystem::remove(directory_ / (baseName_ + counter), ignored)) break;
+  }
+}
+
 std::filesystem::path VtuSeriesWriter::write(const Frame& frame) {
   char counter[32];
   std::snprintf(counter, sizeof counter, "_%06zu.vtu", entries_.size());

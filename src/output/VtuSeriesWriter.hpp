@@ -25,6 +25,12 @@ class VtuSeriesWriter {
   // .pvd fails the frame stays recorded (its file exists) and the next write lists it.
   std::filesystem::path write(const Frame& frame);
 
+  // Continues the series of an interrupted run: the frames written up to its checkpoint are
+  // kept (and the .pvd rewritten to list only them); frame files numbered after them, written
+  // after the checkpoint, are removed, and the next write() takes the next number.
+  void resume(const std::vector<PvdEntry>& frames);
+  const std::vector<PvdEntry>& frames() const { return entries_; }
+
   const std::filesystem::path& directory() const { return directory_; }
   const std::filesystem::path& pvdPath() const { return pvdPath_; }
   std::size_t frameCount() const { return entries_.size(); }

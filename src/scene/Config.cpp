@@ -222,6 +222,14 @@ std::vector<std::string> Config::keys(const std::string& section) const {
   return out;
 }
 
+std::vector<std::pair<std::string, std::string>> Config::settings() const {
+  std::vector<std::pair<std::string, std::string>> out;
+  for (const auto& [section, keys] : entries_)
+    for (const auto& [key, entry] : keys)
+      out.emplace_back(section + "." + key, entry.value);
+  return out;
+}
+
 std::vector<std::string> Config::unusedKeys(const std::string& section) const {
   std::vector<std::string> out;
   for (const auto& key : keys(section))

@@ -43,6 +43,8 @@ class Config {
   // reports them with a did-you-mean.
   std::vector<std::string> unusedKeys(const std::string& section) const;
   std::vector<std::string> keys(const std::string& section) const;
+  // Every entry as ("section.key", value), sorted; does not mark anything used.
+  std::vector<std::pair<std::string, std::string>> settings() const;
 
  private:
   void addSection(const std::string& section, const std::string& where);

@@ -128,6 +128,7 @@ class Builder {
     readInitialConditions();
     readTimeAndDamping();
     readOutput();
+    readCheckpoint();
     readGuard();
     readProbes();
     return std::move(setup_);
@@ -816,6 +817,18 @@ class Builder {
     o.finish();
   }
 
+  // Periodic checkpoints (app/CheckpointSchedule.hpp): by steps, by wall time, the last K kept.
+  void readCheckpoint() {
+    SectionReader c(config_, "checkpoint");
+    setup_.checkpoint.everySteps = c.integer("every_steps", 0);
+    setup_.checkpoint.everySeconds = c.nonNegative("every_seconds", 600.0);
+    setup_.checkpoint.keep = c.integer("keep", 2);
+    if (setup_.checkpoint.keep < 1)
+      throw c.error("keep", "must be at least 1 (the newest checkpoint), got " +
+                                config_.get("checkpoint", "keep"));
+    c.finish();
+  }
+
   // The run's stability guards (RunSimulation.hpp), checked every [static] check_every steps.
   void readGuard() {
     SectionReader g(config_, "guard");
@@ -881,7 +894,7 @@ class Builder {
         "scene",   "kernel",    "hourglass", "time",    "static", "damping",
         "gravity", "output",    "material",  "body",    "hole",   "region",
         "clamp",   "prescribe", "load",      "initial", "probe",  "artificial_viscosity",
-        "guard"};
+        "guard",   "checkpoint"};
     for (const auto& section : config_.sections()) {
       const std::string kind = section.substr(0, section.find('.'));
       if (std::find(kinds.begin(), kinds.end(), kind) != kinds.end()) continue;

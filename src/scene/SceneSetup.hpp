@@ -36,6 +36,13 @@ struct OutputSettings {
   double flushSeconds = 10.0;       // CSV series written at least this often [s of wall time]
 };
 
+// Periodic checkpoints ([checkpoint]); a checkpoint is also written when a signal stops the run.
+struct CheckpointSettings {
+  long everySteps = 0;          // every N steps (Newton: load steps); 0: not by steps
+  double everySeconds = 600.0;  // every T seconds of wall time; 0: not by time
+  long keep = 2;                // the newest K are kept
+};
+
 // The run's stability guards ([guard]), evaluated every RunSettings::checkEvery steps.
 struct GuardSettings {
   double minJacobian = 0.0;   // stop when det F <= this at a body particle
@@ -66,6 +73,7 @@ struct SceneSetup {
   SolverSettings solver;
   RunSettings run;
   OutputSettings output;
+  CheckpointSettings checkpoint;
   GuardSettings guard;
   std::vector<Probe<D>> probes;
   std::vector<std::string> materialNames;  // by material index

@@ -22,32 +22,74 @@ NewtonSolver<D>::NewtonSolver(Scene<D>& scene, Solver<D>& solver, const NewtonSe
 template <int D>
 void NewtonSolver<D>::run(const std::function<bool()>& onStep) {
   const double end = solver_.rampEnd();
-  double done = 0.0;
-  double increment = end > 0.0 ? end / settings_.loadSteps : 0.0;
-  int cuts = 0;
-  bool first = true;
-  while (first || done < end * (1.0 - 1e-12)) {
-    const double target = end > 0.0 ? std::min(end, done + increment) : 0.0;
+  if (!resumed_) {
+    done_ = 0.0;
+    increment_ = end > 0.0 ? end / settings_.loadSteps : 0.0;
+    cuts_ = 0;
+    started_ = false;
+  }
+  resumed_ = false;
+  while (!started_ || done_ < end * (1.0 - 1e-12)) {
+    const double target = end > 0.0 ? std::min(end, done_ + increment_) : 0.0;
     std::string why;
     if (solveAt(target, why)) {
       solver_.finishStaticStep();
       ++statistics_.loadSteps;
-      done = target;
-      first = false;
+      done_ = target;
+      started_ = true;
       if (!onStep()) return;
       continue;
     }
     solver_.abandonStaticStep();  // back to the last converged state
-    if (end <= 0.0 || ++cuts > settings_.maxCuts) {
+    if (end <= 0.0 || ++cuts_ > settings_.maxCuts) {
       std::ostringstream msg;
       msg << "Newton solver: no equilibrium at load time t = " << target << " s";
       if (end > 0.0) msg << " (" << 100.0 * target / end << " % of the load)";
-      msg << ": " << why << ". The output holds the last converged state (t = " << done
+      msg << ": " << why << ". The output holds the last converged state (t = " << done_
           << " s). Try more load steps ([static] load_steps), or solver = damped.";
       throw NewtonFailure(msg.str());
     }
-    increment *= 0.5;
+    increment_ *= 0.5;
   }
+}
+
+template <int D>
+NewtonState<D> NewtonSolver<D>::state() const {
+  NewtonState<D> s;
+  s.done = done_;
+  s.increment = increment_;
+  s.cuts = cuts_;
+  s.started = started_;
+  s.factorised = factorised_;
+  s.lastKrylov = lastKrylov_;
+  s.lastStep = lastStep_;
+  s.statistics = statistics_;
+  if (factorised_) s.factorDeformation = factorDeformation_;
+  return s;
+}
+
+template <int D>
+void NewtonSolver<D>::resume(const NewtonState<D>& s) {
+  done_ = s.done;
+  increment_ = s.increment;
+  cuts_ = s.cuts;
+  started_ = s.started;
+  lastKrylov_ = s.lastKrylov;
+  lastStep_ = s.lastStep;
+  factorised_ = false;
+  if (s.factorised) {
+    // The same matrix as before the stop: the tangent at the saved F, factorised again.
+    if (s.factorDeformation.size() != scene_.particles.displacement.size())
+      throw SetupError("the saved Newton state does not fit the scene (particle count)");
+    tangent_.update(s.factorDeformation);
+    std::string why;
+    if (!factorise(why)) throw NewtonFailure("Newton solver: on restart, " + why);
+    factorDeformation_ = s.factorDeformation;
+  }
+  const std::string linearSolver = statistics_.linearSolver;
+  statistics_ = s.statistics;  // after factorise(), which counts
+  statistics_.linearSolver = linearSolver;
+  resumed_ = true;
 }
 
 template <int D>
@@ -83,6 +125,7 @@ bool NewtonSolver<D>::factorise(std::string& why) {
   statistics_.assemblySeconds += seconds(t0);
   t0 = Clock::now();
   factorised_ = factor_.factorise(K);
+  factorDeformation_ = solver_.forces().deformationGradient();
   statistics_.factorisationSeconds += seconds(t0);
   statistics_.factorNonZeros = factor_.factorNonZeros();
   ++statistics_.factorisations;

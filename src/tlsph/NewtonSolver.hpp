@@ -46,6 +46,22 @@ struct NewtonStatistics {
   std::string linearSolver;
 };
 
+// Where a Newton solve stands between two load steps, for checkpoint/restart: the load reached,
+// the step-size control, and the state the preconditioner was factorised at (the factor is
+// rebuilt from it, so a restarted solve takes the same iterations bit for bit).
+template <int D>
+struct NewtonState {
+  double done = 0.0;       // load time reached
+  double increment = 0.0;  // present load-step length
+  int cuts = 0;
+  bool started = false;  // a first load step has converged
+  bool factorised = false;
+  int lastKrylov = 0;
+  double lastStep = 0.0;
+  NewtonStatistics statistics;
+  std::vector<Mat<D>> factorDeformation;  // F at the last factorisation
+};
+
 // A Newton solve that could not reach equilibrium; the message says at which load and why.
 class NewtonFailure : public std::runtime_error {
   using std::runtime_error::runtime_error;
@@ -62,7 +78,13 @@ class NewtonSolver {
 
   // Solves the load steps up to the end of the ramps; onStep() after each converged one, which
   // returns false to stop there. Throws NewtonFailure with the scene at the last converged state.
+  // After resume(), continues from the saved load step.
   void run(const std::function<bool()>& onStep);
+
+  // The state between load steps (call from onStep), and its restoration into a new solver of
+  // the same scene whose Solver has been restored to the same step.
+  NewtonState<D> state() const;
+  void resume(const NewtonState<D>& state);
 
  private:
   using Clock = std::chrono::steady_clock;
@@ -93,6 +115,11 @@ class NewtonSolver {
   double lastStep_ = 0.0;
   int lastKrylov_ = 0;
   NewtonStatistics statistics_;
+  // Load stepping (run()): the load time reached, the step length, its halvings so far.
+  double done_ = 0.0, increment_ = 0.0;
+  int cuts_ = 0;
+  bool started_ = false, resumed_ = false;
+  std::vector<Mat<D>> factorDeformation_;
 };
 
 extern template class NewtonSolver<2>;

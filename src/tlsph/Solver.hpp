@@ -36,6 +36,23 @@ struct EnergyBalance {
   }
 };
 
+// What a run needs to continue bitwise from where it stopped (checkpoint/restart): the
+// particles' motion, the clock, the kinetic-damping memory and the energy books. Everything
+// else the solver holds (forces, loads, ghost motion) is a function of these.
+template <int D>
+struct SolverState {
+  double time = 0.0;
+  long steps = 0;
+  double previousKinetic = 0.0;
+  long kineticResets = 0;
+  double hourglassWorkDone = 0.0, externalWork = 0.0, boundaryWork = 0.0, damped = 0.0;
+  bool staticBooksStarted = false;
+  std::vector<Vec<D>> displacement, velocity;
+  // The velocities the last force pass saw (mid-step): kept only when the artificial
+  // viscosity reads them.
+  std::vector<Vec<D>> forceVelocity;
+};
+
 template <int D>
 class Solver {
  public:
@@ -85,6 +102,7 @@ class Solver {
         movingMirrors_ = true;
     updateMirrorDrive(0.0);
     mirrorGhostMotion();
+    if (forces_.viscosityEnabled()) forceVelocity_ = scene.particles.velocity;
     forces_.compute(scene.particles.displacement, scene.particles.force, &scene.particles.velocity);
     chainMirrorForces();
     previousKinetic_ = kineticEnergy(scene.particles);
@@ -148,6 +166,7 @@ class Solver {
     }
     mirrorGhostMotion();
     // The artificial viscosity sees the mid-step velocities.
+    if (viscous) forceVelocity_ = p.velocity;
     forces_.compute(p.displacement, p.force, &p.velocity);
     chainMirrorForces();
     for (std::size_t k = 0; k < driveStep.size(); ++k)
@@ -312,12 +331,60 @@ class Solver {
     boundaryWork_ += boundary;
   }
 
+  SolverState<D> state() const {
+    SolverState<D> s;
+    s.time = time_;
+    s.steps = steps_;
+    s.previousKinetic = previousKinetic_;
+    s.kineticResets = kineticResets_;
+    s.hourglassWorkDone = hourglassWorkDone_;
+    s.externalWork = externalWork_;
+    s.boundaryWork = boundaryWork_;
+    s.damped = damped_;
+    s.staticBooksStarted = staticBooksStarted_;
+    s.displacement = scene_.particles.displacement;
+    s.velocity = scene_.particles.velocity;
+    s.forceVelocity = forceVelocity_;
+    return s;
+  }
+
+  // Puts the solver back into a state() of the same scene: the forces are recomputed from the
+  // same inputs as when the state was left, so the run continues bit for bit.
+  void restore(const SolverState<D>& s) {
+    auto& p = scene_.particles;
+    const auto n = static_cast<std::size_t>(p.size());
+    if (s.displacement.size() != n || s.velocity.size() != n ||
+        (forces_.viscosityEnabled() && s.forceVelocity.size() != n))
+      throw SetupError("the saved state holds " + std::to_string(s.displacement.size()) +
+                       " particles, the scene " + std::to_string(n));
+    time_ = s.time;
+    steps_ = s.steps;
+    previousKinetic_ = s.previousKinetic;
+    kineticResets_ = s.kineticResets;
+    hourglassWorkDone_ = s.hourglassWorkDone;
+    externalWork_ = s.externalWork;
+    boundaryWork_ = s.boundaryWork;
+    damped_ = s.damped;
+    staticBooksStarted_ = s.staticBooksStarted;
+    p.displacement = s.displacement;
+    forceVelocity_ = s.forceVelocity;
+    p.velocity = forceVelocity_.empty() ? s.velocity : forceVelocity_;
+    updateMirrorDrive(time_);
+    mirrorGhostMotion();
+    forces_.compute(p.displacement, p.force, &p.velocity);
+    chainMirrorForces();
+    if (hasExternal_) computeExternalForces(time_);
+    p.velocity = s.velocity;
+    mirrorGhostMotion();
+  }
+
   // Recomputes the forces (and the external forces at the current time) for the particles'
   // present displacements and velocities, without advancing: for a state put back from a
   // copy, e.g. to write the last good frame of a run that went unstable.
   void reevaluate() {
     auto& p = scene_.particles;
     mirrorGhostMotion();
+    if (forces_.viscosityEnabled()) forceVelocity_ = p.velocity;
     forces_.compute(p.displacement, p.force, &p.velocity);
     chainMirrorForces();
     if (hasExternal_) computeExternalForces(time_);
@@ -519,6 +586,7 @@ class Solver {
   double externalWork_ = 0.0;
   double boundaryWork_ = 0.0;
   double damped_ = 0.0;
+  std::vector<Vec<D>> forceVelocity_;  // see SolverState::forceVelocity
   // State at the start of a static step (beginStaticStep), for its work books.
   std::vector<Vec<D>> staticStart_, staticForce_, staticExternal_, staticDrive_;
   double staticTime_ = 0.0;
