@@ -2,6 +2,10 @@
 // Compiled once for 2D and 3D.
 #include "tlsph/TangentStiffness.hpp"
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 namespace tlsph {
 
 template <int D>
@@ -69,25 +73,46 @@ void TangentStiffness<D>::apply(const Eigen::VectorXd& v, Eigen::VectorXd& Kv, P
   Kv = -Kv;
 }
 
+// Each thread owns a range of block columns and adds only to those (no atomics), taking the
+// particles in index order: every entry sums its contributions in the same order whatever the
+// thread count, so the matrix, and a Newton solve preconditioned by it, are reproducible bit
+// for bit (checkpoint/restart relies on that). A particle whose stencil straddles two ranges
+// is visited by both threads, each adding its own columns.
 template <int D>
 const typename TangentStiffness<D>::SparseMatrix& TangentStiffness<D>::assemble() {
   if (matrix_.rows() == 0) buildPattern();
   std::fill(matrix_.valuePtr(), matrix_.valuePtr() + matrix_.nonZeros(), 0.0);
   const auto& nb = ref_.neighbours;
+  const Index nd = dofs_.size();
 #pragma omp parallel
   {
+    int thread = 0, threads = 1;
+#ifdef _OPENMP
+    thread = omp_get_thread_num();
+    threads = omp_get_num_threads();
+#endif
+    // Block columns [first, last): an equal share of the stored blocks.
+    auto columnAt = [&](int t) {
+      const Index target = blockStart_[nd] * t / threads;
+      return static_cast<Index>(std::lower_bound(blockStart_.begin(), blockStart_.end(), target) -
+                                blockStart_.begin());
+    };
+    const Index first = std::min(columnAt(thread), nd);
+    const Index last = thread + 1 == threads ? nd : std::min(columnAt(thread + 1), nd);
     Stencil s;
     std::vector<Eigen::Matrix<double, DD, D>> AB;
     Eigen::MatrixXd C, CK;
-#pragma omp for schedule(dynamic, 64)
     for (Index i = 0; i < n_; ++i) {
+      if (stencilLast_[i] < first || stencilFirst_[i] >= last) continue;
       reducedStencil(i, s);
       const Index m = static_cast<Index>(s.dof.size());
       if (m == 0) continue;
+      // This thread's columns of the stencil (sorted by dof): q in [q0, q1).
+      const Index q0 = s.position(first), q1 = s.position(last);
       // local(p, q) blocks, p >= q in dof order (the stencil is sorted by dof)
       if (hasEnergy_[i]) {
         AB.resize(m);
-        for (Index q = 0; q < m; ++q)
+        for (Index q = q0; q < q1; ++q)
           AB[q] = modulus_[i] * kroneckerIdentity(s.b[q]);  // A B_q
       }
       const bool penalty = penalty_ != nullptr;
@@ -107,7 +132,7 @@ const typename TangentStiffness<D>::SparseMatrix& TangentStiffness<D>::assemble(
         for (Index k = 0; k < count; ++k)
           CK.col(k) *= 0.5 * volume_[i] * c_[nb.offset[i] + k];  // 1/2 k_IJ
       }
-      for (Index q = 0; q < m; ++q)
+      for (Index q = q0; q < q1; ++q)
         for (Index p = q; p < m; ++p) {
           Mat<D> block = Mat<D>::Zero();
           if (hasEnergy_[i]) {
@@ -182,8 +207,14 @@ void TangentStiffness<D>::buildPattern() {
   const Index nd = dofs_.size();
   std::vector<std::vector<Index>> rows(nd);
   Stencil s;
+  stencilFirst_.assign(n_, nd);
+  stencilLast_.assign(n_, -1);
   for (Index i = 0; i < n_; ++i) {
     reducedStencil(i, s);
+    if (!s.dof.empty()) {
+      stencilFirst_[i] = s.dof.front();
+      stencilLast_[i] = s.dof.back();
+    }
     for (std::size_t q = 0; q < s.dof.size(); ++q)
       for (std::size_t p = q; p < s.dof.size(); ++p)
         rows[s.dof[q]].push_back(s.dof[p]);
@@ -225,10 +256,8 @@ void TangentStiffness<D>::addBlock(Index p, Index q, const Mat<D>& block) {
   double* values = matrix_.valuePtr();
   for (int k = 0; k < D; ++k) {
     const Index start = blockStart_[q] * DD + k * D * L + D * r;
-    for (int i = 0; i < D; ++i) {
-#pragma omp atomic
+    for (int i = 0; i < D; ++i)
       values[start + i] += block(i, k);
-    }
   }
 }
 

@@ -153,6 +153,7 @@ class TangentStiffness {
   std::vector<Vec<D>> full_, df_;
   std::vector<Mat<D>> dF_, dS_;  // per particle: dH = dF and A : dH
   std::vector<Index> blockStart_, blockRows_;
+  std::vector<Index> stencilFirst_, stencilLast_;  // per particle: its stencil's dof range
   SparseMatrix matrix_;
 };
 
