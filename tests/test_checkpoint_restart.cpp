@@ -155,8 +155,8 @@ TEST_F(CheckpointRestart, NewtonStatic3DNonlinearContinuesBitForBit) {
                  randomStep(1, 2));
 }
 
-// SIGTERM at a random moment: exit 143 with a checkpoint; restarting from it ('latest') ends
-// exactly where the uninterrupted run ends.
+// SIGTERM at a random moment once the run has begun (its first series written): exit 143 with a
+// checkpoint; restarting from it ('latest') ends exactly where the uninterrupted run ends.
 TEST_F(CheckpointRestart, TerminatedRunRestartsFromItsCheckpoint) {
   const std::string args =
       scene("examples/hourglass_block.ini") + " --time.end=0.15 --output.every_time=0.01";
@@ -169,7 +169,8 @@ TEST_F(CheckpointRestart, TerminatedRunRestartsFromItsCheckpoint) {
   const std::string command =
       "sh -c '" + std::string(TLSPH_PROGRAM) + " run " + args +
       " --output.directory=" + cut.string() + " > " + (dir_ / "b.log").string() +
-      " 2>&1 & pid=$!; sleep " + std::to_string(delayMs / 1000.0) +
+      " 2>&1 & pid=$!; while [ ! -f " + (cut / "energies.csv").string() +
+      " ]; do sleep 0.02; done; sleep " + std::to_string(delayMs / 1000.0) +
       "; kill -TERM $pid; wait $pid; echo $? > " + (dir_ / "status").string() + "'";
   ASSERT_EQ(std::system(command.c_str()), 0);
   int status = -1;
