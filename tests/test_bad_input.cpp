@@ -5,7 +5,8 @@
 // tests/bad-input/README.md):
 //   # expect: error | warning
 //   # message: <substring the output must hold>       (one or more)
-//   # args: <extra command-line arguments>            (optional, appended as given)
+//   # args: <extra command-line arguments>            (optional, appended as given; {catalogue}
+//                                                     stands for tests/bad-input)
 //   # scene: <path instead of this file>              (optional, relative to tests/bad-input)
 //   # command: check | run                            (optional, default check)
 #include <gtest/gtest.h>
@@ -55,7 +56,13 @@ Expectation readExpectation(const fs::path& file) {
     const std::string key = line.substr(0, colon), value = trim(line.substr(colon + 1));
     if (key == "expect") e.expect = value;
     if (key == "message") e.messages.push_back(value);
-    if (key == "args") e.args += (e.args.empty() ? "" : " ") + value;
+    if (key == "args") {
+      // {catalogue} stands for this directory (files the arguments name, e.g. checkpoints)
+      std::string v = value;
+      for (auto at = v.find("{catalogue}"); at != std::string::npos; at = v.find("{catalogue}"))
+        v.replace(at, 11, kCatalogue.string());
+      e.args += (e.args.empty() ? "" : " ") + v;
+    }
     if (key == "scene") e.scene = file.parent_path() / value;
     if (key == "command") e.command = value;
   }
