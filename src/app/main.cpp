@@ -204,6 +204,29 @@ void addSolverWarnings(SceneSetup<D>& setup, const Solver<D>& solver, const std:
   std::cerr << command << ": warning: " << w.str() << "\n";
 }
 
+int ompThreads() {
+#ifdef _OPENMP
+  return omp_get_max_threads();
+#else
+  return 1;
+#endif
+}
+
+// What a checkpoint records to recognise its run: version, scene text, overrides, settings.
+CheckpointOrigin runOrigin(const Config& config, const RunFlags& flags, int threads) {
+  CheckpointOrigin origin;
+  origin.version = kVersion;
+  origin.sceneFile = flags.sceneFile;
+  std::ifstream in(flags.sceneFile, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  origin.sceneText = text.str();
+  origin.overrides = flags.overrides;
+  origin.settings = config.settings();
+  origin.threads = threads;
+  return origin;
+}
+
 template <int D>
 int runOrCheck(const Config& config, bool run, bool progress, const std::string& command,
                const RunFlags& flags) {
@@ -217,24 +240,11 @@ int runOrCheck(const Config& config, bool run, bool progress, const std::string&
     printSetup(setup, solver);
     return 0;
   }
-  int threads = 1;
-#ifdef _OPENMP
-  threads = omp_get_max_threads();
-#endif
+  const int threads = ompThreads();
   RunOptions options;
   options.progress = progress;
   options.command = command;
-  options.origin.version = kVersion;
-  options.origin.sceneFile = flags.sceneFile;
-  {
-    std::ifstream in(flags.sceneFile, std::ios::binary);
-    std::stringstream text;
-    text << in.rdbuf();
-    options.origin.sceneText = text.str();
-  }
-  options.origin.overrides = flags.overrides;
-  options.origin.settings = config.settings();
-  options.origin.threads = threads;
+  options.origin = runOrigin(config, flags, threads);
 
   std::optional<Checkpoint<D>> resume;
   if (!flags.restart.empty()) {
@@ -428,6 +438,7 @@ int main(int argc, char** argv) {
     if (verb == "modes") {
       modes.run.command = command;
       modes.run.progress = progress;
+      modes.run.origin = runOrigin(config, flags, ompThreads());
       if (d == 2) {
         SceneSetup<2> setup = buildScene<2>(config);
         return runModes<2>(setup, modes);
