@@ -220,6 +220,14 @@ class Builder {
     setup_.scene.gradientCorrection =
         parseGradientCorrection(k.word("correction", "quadratic", {"linear", "quadratic"}));
     setup_.scene.supportRadius = ratio * setup_.dx;
+    // Issue 8: nodal = the one-point sum_I V_I psi(F_I); taylor adds its second-order
+    // correction (TaylorQuadrature.hpp; quadratic correction only).
+    setup_.scene.taylorQuadrature = k.word("quadrature", "nodal", {"nodal", "taylor"}) == "taylor";
+    if (setup_.scene.taylorQuadrature &&
+        setup_.scene.gradientCorrection != GradientCorrection::Quadratic)
+      throw k.error("quadrature",
+                    "taylor needs correction = quadratic (its second derivatives come from the "
+                    "quadratic fit)");
     k.finish();
     SectionReader h(config_, "hourglass");
     setup_.scene.hourglassCoefficient = h.nonNegative("alpha", 10.0);

@@ -98,6 +98,7 @@ ModalResult<D> computeModes(const Scene<D>& scene, Solver<D>& solver,
   TangentStiffness<D> K(solver.reference(), scene.materials, p.material, p.volume,
                         scene.hourglass(), dofs);
   K.update(solver.forces().deformationGradient());
+  K.updateQuadrature(solver.forces().quadrature(), solver.forces().deformationGradient());
   Eigen::VectorXd mass(n);
   for (Index d = 0; d < dofs.size(); ++d)
     mass.template segment<D>(D * d).setConstant(p.mass[dofs.freeParticles()[d]]);

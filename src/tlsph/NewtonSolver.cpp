@@ -191,6 +191,7 @@ bool NewtonSolver<D>::solveAt(double t, std::string& why) {
     // The exact tangent at the present state for the product; the factorised matrix, only a
     // preconditioner, is renewed when it has gone stale (too many conjugate-gradient iterations).
     tangent_.update(solver_.forces().deformationGradient());
+    tangent_.updateQuadrature(solver_.forces().quadrature(), solver_.forces().deformationGradient());
     if (!factorised_ || lastKrylov_ > kRefactorAfter)
       if (!factorise(why)) return false;
     if (!solveLinear(r, du, why)) {

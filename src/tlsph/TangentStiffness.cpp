@@ -55,6 +55,10 @@ void TangentStiffness<D>::apply(const Eigen::VectorXd& v, Eigen::VectorXd& Kv, P
       S = &penaltyStress_;
     }
   }
+  const bool quadrature = quadrature_ && part != Part::Penalty;
+  if (quadrature)
+    quadrature_->linearise(full_, dF_, quadratureF_, quadratureG_,
+                           S == &penaltyStress_ ? penaltyStress_ : dS_);
 #pragma omp parallel for schedule(static)
   for (Index i = 0; i < n_; ++i) {
     const auto& St = *S;
@@ -68,6 +72,7 @@ void TangentStiffness<D>::apply(const Eigen::VectorXd& v, Eigen::VectorXd& Kv, P
     }
     df_[i] = volume_[i] * f;
     if (penalty) df_[i] += penalty_->springForce(i);
+    if (quadrature) df_[i] += quadrature_->force(i);
   }
   dofs_.gather(df_, Kv);
   Kv = -Kv;

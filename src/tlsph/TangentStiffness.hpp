@@ -29,6 +29,7 @@
 #include "tlsph/HourglassStiffness.hpp"
 #include "tlsph/PairTerms.hpp"
 #include "tlsph/ReferenceConfiguration.hpp"
+#include "tlsph/TaylorQuadrature.hpp"
 #include "tlsph/Types.hpp"
 
 namespace tlsph {
@@ -80,6 +81,15 @@ class TangentStiffness {
       }
       penaltyStress_.assign(n_, Mat<D>::Zero());
     }
+    if (hourglass.taylorQuadrature) {
+      quadrature_ = std::make_unique<TaylorQuadrature<D>>(ref, materials, materialOf, volume,
+                                                          isPassive);
+      quadratureF_.assign(n_, Mat<D>::Identity());
+      quadratureG_.assign(n_, typename TaylorQuadrature<D>::Gradients{});
+      for (auto& g : quadratureG_)
+        for (auto& m : g)
+          m.setZero();
+    }
     full_.assign(n_, Vec<D>::Zero());
     dF_.assign(n_, Mat<D>::Zero());
     dS_.assign(n_, Mat<D>::Zero());
@@ -87,12 +97,19 @@ class TangentStiffness {
   }
 
   // True when assemble() is the exact K (no penalty); otherwise it bounds the penalty's part.
-  bool assemblyExact() const { return !hourglass_.enabled(); }
+  bool assemblyExact() const { return !hourglass_.enabled() && !quadrature_; }
   Index size() const { return D * dofs_.size(); }
 
   // The material tangents A_I = dP/dF at the deformation gradients F (every particle's; the
   // passive ones are not used).
   void update(const std::vector<Mat<D>>& F);
+  // The state of the quadrature correction (TaylorQuadrature; F and its second gradients from
+  // the last force pass); the assembled matrix leaves that term out (a preconditioner then).
+  void updateQuadrature(const TaylorQuadrature<D>* q, const std::vector<Mat<D>>& F) {
+    if (!quadrature_ || !q) return;
+    quadratureF_ = F;
+    quadratureG_ = q->secondGradients();
+  }
 
   // Kv = K v, exactly (v and Kv: D values per unknown, stacked).
   // Which part of K a product takes: all of it, the strain energy's, or the penalty's.
@@ -147,6 +164,9 @@ class TangentStiffness {
   std::vector<Modulus> modulus_;
   std::vector<double> c_;
   std::unique_ptr<EnergyHourglass<D>> penalty_;
+  std::unique_ptr<TaylorQuadrature<D>> quadrature_;
+  std::vector<Mat<D>> quadratureF_;
+  std::vector<typename TaylorQuadrature<D>::Gradients> quadratureG_;
   bool separate_ = false;  // the penalty compares with the linear F (its own vectors)
   std::vector<Vec<D>> linearReverse_, linearSum_;
   std::vector<Mat<D>> hourglassH_, penaltyStress_;

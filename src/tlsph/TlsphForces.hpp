@@ -23,6 +23,7 @@
 #include "tlsph/HourglassStiffness.hpp"
 #include "tlsph/PairTerms.hpp"
 #include "tlsph/ReferenceConfiguration.hpp"
+#include "tlsph/TaylorQuadrature.hpp"
 #include "tlsph/Types.hpp"
 
 namespace tlsph {
@@ -54,6 +55,11 @@ class TlsphForces {
       if (isPassive.empty() || !isPassive[i])
         particlesOfMaterial_.at(materialOfParticle[i]).push_back(i);
     passive_ = passive;
+    if (hourglass.taylorQuadrature) {
+      quadrature_ = std::make_unique<TaylorQuadrature<D>>(reference, materials, materialOfParticle,
+                                                          volume, isPassive);
+      quadratureStress_.assign(n, Mat<D>::Zero());
+    }
     if (hourglass.enabled()) {
       auto c = hourglassPairCoefficients(reference, materials, materialOfParticle, volume,
                                          hourglass.alpha, isPassive);
@@ -103,11 +109,19 @@ class TlsphForces {
     if (energyHourglass_ && separateHourglassGradient_) {
       // P^hg of the linear F goes through the linear gradient vectors: its own sum.
       energyHourglass_->evaluate(u, hourglassF_, nullptr, stress_);
+      if (quadrature_) {
+        quadratureStress_ = P_;
+        quadrature_->evaluate(u, F_, quadratureStress_);
+      }
       viscous ? accumulateForces<false, true, true>(u, f, v)
               : accumulateForces<false, false, true>(u, f, v);
       return;
     }
     if (energyHourglass_) energyHourglass_->evaluate(u, F_, &P_, stress_);
+    if (quadrature_) {
+      quadratureStress_ = energyHourglass_ ? stress_ : P_;
+      quadrature_->evaluate(u, F_, quadratureStress_);
+    }
     if (ganzenmueller_)
       viscous ? accumulateForces<true, true>(u, f, v) : accumulateForces<true, false>(u, f, v);
     else
@@ -141,8 +155,12 @@ class TlsphForces {
           },
           materials_[m]);
     }
+    if (quadrature_) total += quadrature_->energy(F_);  // E_q: part of the strain energy
     return total;
   }
+
+  // The quadrature correction (null unless [kernel] quadrature = taylor).
+  const TaylorQuadrature<D>* quadrature() const { return quadrature_.get(); }
 
   // E_hg of the energy form for the displacements u of the last compute() (0 otherwise).
   double hourglassEnergy(const std::vector<Vec<D>>& u) const {
@@ -212,7 +230,9 @@ class TlsphForces {
     const Index n = ref_.particleCount();
     // The stress the force pass sends through the gradient vectors: P, or P + P^hg (or P,
     // and P^hg through the linear vectors).
-    const std::vector<Mat<D>>& S = energyHourglass_ && !SeparateHourglassStress ? stress_ : P_;
+    const std::vector<Mat<D>>& S = quadrature_ ? quadratureStress_
+                                   : energyHourglass_ && !SeparateHourglassStress ? stress_
+                                                                                 : P_;
     const std::vector<Mat<D>>& Fh = separateHourglassGradient_ ? hourglassF_ : F_;
 #pragma omp parallel for schedule(static)
     for (Index i = 0; i < n; ++i) {
@@ -235,6 +255,7 @@ class TlsphForces {
       }
       Vec<D> total = volume_[i] * internal;
       if (energyHourglass_) total += energyHourglass_->springForce(i);
+      if (quadrature_) total += quadrature_->force(i);
       if constexpr (Ganzenmueller) {
         hourglassForce_[i] = volume_[i] * hourglass;
         total += hourglassForce_[i];
@@ -261,6 +282,8 @@ class TlsphForces {
   std::vector<Mat<D>> hourglassF_;
   std::vector<double> hourglassStiffness_;  // K_I
   std::unique_ptr<EnergyHourglass<D>> energyHourglass_;
+  std::unique_ptr<TaylorQuadrature<D>> quadrature_;
+  std::vector<Mat<D>> quadratureStress_;  // the force pass's stress plus P^q
   std::unique_ptr<GanzenmuellerHourglass<D>> ganzenmueller_;
   std::unique_ptr<ArtificialViscosity<D>> viscosity_;
   std::vector<Vec<D>> hourglassForce_;

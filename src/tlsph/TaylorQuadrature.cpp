@@ -1,0 +1,94 @@
+// TaylorQuadrature's set-up (see the header), compiled once for 2D and 3D: the fit's moment
+// matrices are inverted here (Eigen's dense eigensolver), out of every file that includes the
+// force pass.
+#include "tlsph/TaylorQuadrature.hpp"
+
+namespace tlsph {
+
+template <int D>
+TaylorQuadrature<D>::TaylorQuadrature(const ReferenceConfiguration<D>& ref,
+                                      const std::vector<Material>& materials,
+                                      const std::vector<std::uint16_t>& materialOf,
+                                      const std::vector<double>& volume,
+                                      const std::vector<std::uint8_t>& passive)
+    : ref_(ref), volume_(volume) {
+  const auto& nb = ref.neighbours;
+  const Index n = ref.particleCount();
+  S_.assign(nb.pairCount(), Sym::Zero());
+  sum_.assign(n, Sym::Zero());
+  weight_.assign(n, 0.0);
+  lambda_.assign(n, 0.0);
+  mu_.assign(n, 0.0);
+  std::vector<std::uint8_t> fallback(n, 0);
+  for (Index i : ref.linearFallback)
+    fallback[i] = 1;
+  constexpr int T = D + D * (D + 1) / 2;
+  using Moment = Eigen::Matrix<double, T, T>;
+  using Basis = Eigen::Matrix<double, T, 1>;
+  for (Index i = 0; i < n; ++i) {
+    const bool energy = passive.empty() || !passive[i];
+    if (energy) {
+      const auto& c = elasticConstants(materials[materialOf[i]]);
+      const double l = std::pow(volume[i], 1.0 / D);
+      weight_[i] = l * l / 12.0;
+      lambda_[i] = c.lambda;
+      mu_[i] = c.mu;
+    }
+    if (ref.correction != GradientCorrection::Quadratic || fallback[i]) continue;
+    // The fit of ReferenceConfiguration (scale-free: the basis is scaled by l for conditioning).
+    const double l = std::pow(volume[i], 1.0 / D);
+    auto basis = [&](Index k) {
+      const Vec<D> d = -ref.separation[k] / l;
+      Basis p;
+      int t = 0;
+      for (int a = 0; a < D; ++a)
+        p[t++] = d[a];
+      for (int a = 0; a < D; ++a)
+        for (int b = a; b < D; ++b)
+          p[t++] = d[a] * d[b];
+      return p;
+    };
+    Moment M = Moment::Zero();
+    for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
+      const Basis p = basis(k);
+      M.noalias() += (volume[nb.neighbour[k]] * ref.kernelValue[k]) * p * p.transpose();
+    }
+    const Eigen::SelfAdjointEigenSolver<Moment> eigen(M);
+    const Moment Minv = eigen.eigenvectors() * eigen.eigenvalues().cwiseInverse().asDiagonal() *
+                        eigen.eigenvectors().transpose();
+    for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
+      const Basis c = (volume[nb.neighbour[k]] * ref.kernelValue[k]) * (Minv * basis(k));
+      Sym s;
+      int t = 0;
+      for (int a = 0; a < D; ++a)
+        for (int b = a; b < D; ++b, ++t) {
+          const double v = c[D + t] / (l * l);
+          s[t] = a == b ? 2.0 * v : v;  // S_IJ(a, b)
+        }
+      S_[k] = s;
+      sum_[i] += s;
+    }
+  }
+  // T_IJ = (V_J / V_I) S_JI
+  reverse_.assign(nb.pairCount(), Sym::Zero());
+  for (Index i = 0; i < n; ++i)
+    for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
+      const Index j = nb.neighbour[k];
+      const auto first = nb.neighbour.begin() + nb.offset[j];
+      const auto last = nb.neighbour.begin() + nb.offset[j + 1];
+      const auto at = std::lower_bound(first, last, i);
+      if (at != last && *at == i)
+        reverse_[k] = (volume[j] / volume[i]) * S_[at - nb.neighbour.begin()];
+    }
+  G_.assign(n, Gradients{});
+  for (auto& g : G_)
+    for (auto& m : g)
+      m.setZero();
+  R_.assign(n, SymMatrix::Zero());
+  force_.assign(n, Vec<D>::Zero());
+}
+
+template class TaylorQuadrature<2>;
+template class TaylorQuadrature<3>;
+
+}  // namespace tlsph
