@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -94,7 +95,7 @@ class CheckpointRestart : public ::testing::Test {
   // Runs `arguments` uninterrupted into `full`, with a checkpoint every `every` steps; copies
   // the output as it stands at the end (later rows and frames included, as a crash leaves them)
   // and restarts the copy from the checkpoint at step `every`; the two must be identical.
-  void restartMatches(const std::string& arguments, long every) {
+  void restartMatches(const std::string& arguments, long every, int restartThreads = 0) {
     const fs::path full = dir_ / "full", cont = dir_ / "continued";
     const std::string common = arguments + " --checkpoint.every_steps=" + std::to_string(every) +
                                " --checkpoint.keep=1000";
@@ -103,10 +104,24 @@ class CheckpointRestart : public ::testing::Test {
     const auto checkpoints = checkpointsIn(full);
     ASSERT_GE(checkpoints.size(), 2u) << r.output;  // one to restart from, and a later one
     fs::copy(full, cont, fs::copy_options::recursive);
+    // The restart on another thread count (results do not depend on it).
+    const char* before = std::getenv("OMP_NUM_THREADS");
+    const std::string saved = before ? before : "";
+    if (restartThreads > 0) {
+      ::setenv("OMP_NUM_THREADS", std::to_string(restartThreads).c_str(), 1);
+      ::setenv("OMP_WAIT_POLICY", "passive", 1);
+    }
     const fs::path from = cont / "checkpoints" / checkpoints.front().filename();
     r = runProgram(
         "run " + common + " --output.directory=" + cont.string() + " --restart=" + from.string(),
         dir_ / "b.log");
+    if (restartThreads > 0) {
+      if (before)
+        ::setenv("OMP_NUM_THREADS", saved.c_str(), 1);
+      else
+        ::unsetenv("OMP_NUM_THREADS");
+      ::unsetenv("OMP_WAIT_POLICY");
+    }
     ASSERT_EQ(r.status, 0) << r.output;
     EXPECT_NE(r.output.find("restart      from"), std::string::npos) << r.output;
     expectSameOutput(full, cont);
@@ -125,6 +140,18 @@ long randomStep(long lo, long hi) {
 
 TEST_F(CheckpointRestart, Dynamic3DContinuesBitForBit) {
   restartMatches(scene("examples/hourglass_block.ini"), randomStep(50, 400));
+}
+
+// A checkpoint written on one thread continues on three to the same bits (nothing in a run
+// depends on the thread count: test_thread_independence).
+TEST_F(CheckpointRestart, RestartOnAnotherThreadCountContinuesBitForBit) {
+  restartMatches(scene("examples/hourglass_block.ini"), randomStep(50, 400), 3);
+}
+
+TEST_F(CheckpointRestart, NewtonRestartOnAnotherThreadCountContinuesBitForBit) {
+  restartMatches(scene("validation/scenes/cantilever_large.ini") +
+                     " --scene.dx=0.025 --static.solver=newton --static.load_steps=4",
+                 2, 2);
 }
 
 TEST_F(CheckpointRestart, Dynamic2DContinuesBitForBit) {

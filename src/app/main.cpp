@@ -56,7 +56,7 @@ run options:
   --restart=CHECKPOINT         continue the run from a checkpoint (a file written under
                                OUTPUT/checkpoints/, or 'latest'); the scene must be the same
                                ([checkpoint] settings may differ) and the result is bit for
-                               bit that of the uninterrupted run (same thread count)
+                               bit that of the uninterrupted run (any thread count)
 
 exit status: 0 finished (or a static run converged), 1 bad input or set-up, 3 a static
 run did not converge, 4 the run went unstable (a [guard] check failed: the message names
@@ -258,12 +258,6 @@ int runOrCheck(const Config& config, bool run, bool progress, const std::string&
     if (!why.empty())
       throw CheckpointError("cannot restart from checkpoint " + file.string() + ": " + why);
     resume = readCheckpoint<D>(reader);
-    if (resume->origin.threads != threads)
-      std::cerr << command << ": warning: the checkpoint was written by a run on "
-                << resume->origin.threads << " thread(s), this one has " << threads
-                << ": it continues the run, but bit-for-bit equality with an uninterrupted run "
-                   "needs the same count (OMP_NUM_THREADS="
-                << resume->origin.threads << ")\n";
     std::cout << "restart      from " << file.string() << " (step " << resume->solver.steps
               << ", t = " << resume->solver.time << " s)\n";
   }

@@ -6,6 +6,7 @@
 #include <limits>
 #include <vector>
 
+#include "tlsph/OrderedSum.hpp"
 #include "tlsph/Particles.hpp"
 #include "tlsph/ReferenceConfiguration.hpp"
 #include "tlsph/Types.hpp"
@@ -15,12 +16,9 @@ namespace tlsph {
 // Kinetic energy of the particles the integrator moves (prescribed ones are boundary).
 template <int D>
 double kineticEnergy(const ParticleSet<D>& p) {
-  double sum = 0.0;
-  const Index n = p.size();
-#pragma omp parallel for reduction(+ : sum) schedule(static)
-  for (Index i = 0; i < n; ++i)
-    if (p.motion[i] == Motion::Free) sum += 0.5 * p.mass[i] * p.velocity[i].squaredNorm();
-  return sum;
+  return orderedSum(p.size(), [&](Index i) {
+    return p.motion[i] == Motion::Free ? 0.5 * p.mass[i] * p.velocity[i].squaredNorm() : 0.0;
+  });
 }
 
 // Hourglass content of a displacement field u with displacement gradients H (H = F - 1):
@@ -33,17 +31,16 @@ double hourglassContent(const ReferenceConfiguration<D>& ref, const std::vector<
                         const std::vector<Vec<D>>& u, const std::vector<Mat<D>>& H) {
   const auto& nb = ref.neighbours;
   const Index n = ref.particleCount();
-  double error = 0.0, total = 0.0;
-#pragma omp parallel for reduction(+ : error, total) schedule(static)
-  for (Index i = 0; i < n; ++i)
+  const auto s = orderedSums<2>(n, [&](Index i, std::array<double, 2>& sums) {
     for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
       const Index j = nb.neighbour[k];
       const double w = ref.kernelValue[k] * volume[j];
       const Vec<D> d = u[i] - u[j];
-      error += w * (d - 0.5 * (H[i] + H[j]) * ref.separation[k]).squaredNorm();
-      total += w * d.squaredNorm();
+      sums[0] += w * (d - 0.5 * (H[i] + H[j]) * ref.separation[k]).squaredNorm();
+      sums[1] += w * d.squaredNorm();
     }
-  return total > 0.0 ? error / total : 0.0;
+  });
+  return s[1] > 0.0 ? s[0] / s[1] : 0.0;
 }
 
 template <int D>

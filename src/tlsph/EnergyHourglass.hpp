@@ -10,6 +10,7 @@
 
 #include <vector>
 
+#include "tlsph/OrderedSum.hpp"
 #include "tlsph/ReferenceConfiguration.hpp"
 #include "tlsph/Types.hpp"
 
@@ -77,9 +78,7 @@ class EnergyHourglass {
   double energy(const std::vector<Vec<D>>& u, const std::vector<Mat<D>>& F) const {
     const auto& nb = ref_.neighbours;
     const Index n = ref_.particleCount();
-    double total = 0.0;
-#pragma omp parallel for reduction(+ : total) schedule(static)
-    for (Index i = 0; i < n; ++i) {
+    return orderedSum(n, [&](Index i) {
       double squares = 0.0;
       for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
         const Index j = nb.neighbour[k];
@@ -87,9 +86,8 @@ class EnergyHourglass {
         const Vec<D> e = (u[i] - u[j]) - 0.5 * ((F[i] + F[j]) * Xij - 2.0 * Xij);
         squares += c_[k] * e.squaredNorm();
       }
-      total += 0.25 * volume_[i] * squares;
-    }
-    return total;
+      return 0.25 * volume_[i] * squares;
+    });
   }
 
  private:

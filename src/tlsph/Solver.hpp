@@ -8,6 +8,7 @@
 
 #include "tlsph/Diagnostics.hpp"
 #include "tlsph/Errors.hpp"
+#include "tlsph/OrderedSum.hpp"
 #include "tlsph/ReferenceConfiguration.hpp"
 #include "tlsph/Scene.hpp"
 #include "tlsph/TimeStep.hpp"
@@ -134,17 +135,20 @@ class Solver {
 
     // Kick and drift; each work term is integrated with the trapezoidal rule over the
     // drift: half with the forces before it, half with the forces after it.
-#pragma omp parallel for reduction(+ : hourglassWork, externalWork, dampingWork) schedule(static)
-    for (Index k = 0; k < nFree; ++k) {
+    // Sums in a fixed order (OrderedSum.hpp): 0 hourglass, 1 external, 2 damping work.
+    const auto kick = orderedSums<3>(nFree, [&](Index k, std::array<double, 3>& w) {
       const Index i = free_[k];
       p.velocity[i] += halfDt * (totalForce(i) / p.mass[i] - c * p.velocity[i]);
       const Vec<D> du = dt_ * p.velocity[i];
       p.displacement[i] += du;
-      dampingWork += c * p.mass[i] * p.velocity[i].dot(du);
-      if (hasExternal_) externalWork += 0.5 * external_[i].dot(du);
-      if (hourglass) hourglassWork += 0.5 * forces_.hourglassForce()[i].dot(du);
-      if (viscous) dampingWork -= 0.5 * forces_.viscousForce()[i].dot(du);
-    }
+      w[2] += c * p.mass[i] * p.velocity[i].dot(du);
+      if (hasExternal_) w[1] += 0.5 * external_[i].dot(du);
+      if (hourglass) w[0] += 0.5 * forces_.hourglassForce()[i].dot(du);
+      if (viscous) w[2] -= 0.5 * forces_.viscousForce()[i].dot(du);
+    });
+    hourglassWork += kick[0];
+    externalWork += kick[1];
+    dampingWork += kick[2];
     for (Index k = 0; k < nPrescribed; ++k) {
       const Index i = prescribed_[k];
       step_[k] = prescribedMove(k, time_ + dt_) - p.displacement[i];
@@ -173,19 +177,21 @@ class Solver {
       boundaryWork -= 0.5 * p.force[scene_.mirrorGhosts[k].ghost].dot(driveStep[k]);
     if (hasExternal_) computeExternalForces(time_);
 
-    double kinetic = 0.0;
-#pragma omp parallel for reduction(+ : hourglassWork, externalWork, dampingWork, kinetic) \
-    schedule(static)
-    for (Index k = 0; k < nFree; ++k) {
+    // 0 hourglass, 1 external, 2 damping work, 3 kinetic energy (fixed order: OrderedSum.hpp).
+    const auto kick2 = orderedSums<4>(nFree, [&](Index k, std::array<double, 4>& w) {
       const Index i = free_[k];
       const Vec<D> du = dt_ * p.velocity[i];  // still the mid-step velocity
-      if (hasExternal_) externalWork += 0.5 * external_[i].dot(du);
-      if (hourglass) hourglassWork += 0.5 * forces_.hourglassForce()[i].dot(du);
-      if (viscous) dampingWork -= 0.5 * forces_.viscousForce()[i].dot(du);
+      if (hasExternal_) w[1] += 0.5 * external_[i].dot(du);
+      if (hourglass) w[0] += 0.5 * forces_.hourglassForce()[i].dot(du);
+      if (viscous) w[2] -= 0.5 * forces_.viscousForce()[i].dot(du);
       // Viscous damping taken implicitly in the second kick: stable for any c.
       p.velocity[i] = (p.velocity[i] + halfDt * totalForce(i) / p.mass[i]) / (1.0 + c * halfDt);
-      kinetic += 0.5 * p.mass[i] * p.velocity[i].squaredNorm();
-    }
+      w[3] += 0.5 * p.mass[i] * p.velocity[i].squaredNorm();
+    });
+    hourglassWork += kick2[0];
+    externalWork += kick2[1];
+    dampingWork += kick2[2];
+    double kinetic = kick2[3];
     for (Index k = 0; k < nPrescribed; ++k) {
       const Index i = prescribed_[k];
       boundaryWork -= 0.5 * p.force[i].dot(step_[k]);
@@ -239,9 +245,7 @@ class Solver {
     return reference > 0.0 ? std::sqrt(residual / reference) : std::sqrt(residual);
   }
 
-  long kineticDampingResets() const {
-    return kineticResets_;
-  }
+  long kineticDampingResets() const { return kineticResets_; }
 
   // The longest load or prescription ramp: a static run cannot have converged before it.
   double rampEnd() const {
@@ -269,15 +273,11 @@ class Solver {
   }
 
   // The particles the integrator moves (the unknowns of a static solve).
-  const std::vector<Index>& freeParticles() const {
-    return free_;
-  }
+  const std::vector<Index>& freeParticles() const { return free_; }
 
   // Internal plus external force on particle i at the last evaluation (for a free particle,
   // with the forces of the mirrored ghosts that follow it): the out-of-balance force.
-  Vec<D> netForce(Index i) const {
-    return totalForce(i);
-  }
+  Vec<D> netForce(Index i) const { return totalForce(i); }
 
   // Puts the scene in the static state of load time t, for solvers that find equilibrium
   // directly (NewtonSolver): prescribed particles and moving mirrored faces at their

@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "materials/Material.hpp"
+#include "tlsph/OrderedSum.hpp"
 #include "tlsph/ReferenceConfiguration.hpp"
 #include "tlsph/Types.hpp"
 
@@ -127,19 +128,15 @@ class TaylorQuadrature {
 
   // E_q at the state of the last evaluate().
   double energy(const std::vector<Mat<D>>& F) const {
-    double total = 0.0;
-    const Index n = ref_.particleCount();
-#pragma omp parallel for reduction(+ : total) schedule(static)
-    for (Index i = 0; i < n; ++i) {
-      if (weight_[i] == 0.0) continue;
+    return orderedSum(ref_.particleCount(), [&](Index i) {
+      if (weight_[i] == 0.0) return 0.0;
       double e = 0.0;
       for (int a = 0; a < D; ++a) {
         const Mat<D> ea = F[i].transpose() * G_[i][a];
         e += (stressOf(i, ea).array() * (0.5 * (ea + ea.transpose())).array()).sum();
       }
-      total += 0.5 * volume_[i] * weight_[i] * e;  // V l^2 / 24 sum_a e_a : C0 : e_a
-    }
-    return total;
+      return 0.5 * volume_[i] * weight_[i] * e;  // V l^2 / 24 sum_a e_a : C0 : e_a
+    });
   }
 
  private:

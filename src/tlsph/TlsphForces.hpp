@@ -21,6 +21,7 @@
 #include "tlsph/EnergyHourglass.hpp"
 #include "tlsph/GanzenmuellerHourglass.hpp"
 #include "tlsph/HourglassStiffness.hpp"
+#include "tlsph/OrderedSum.hpp"
 #include "tlsph/PairTerms.hpp"
 #include "tlsph/ReferenceConfiguration.hpp"
 #include "tlsph/TaylorQuadrature.hpp"
@@ -146,12 +147,9 @@ class TlsphForces {
       const auto& group = particlesOfMaterial_[m];
       total += std::visit(
           [&](const auto& model) {
-            double sum = 0.0;
-            const Index count = static_cast<Index>(group.size());
-#pragma omp parallel for reduction(+ : sum) schedule(static)
-            for (Index p = 0; p < count; ++p)
-              sum += volume_[group[p]] * strainEnergyDensity<D>(model, F_[group[p]]);
-            return sum;
+            return orderedSum(static_cast<Index>(group.size()), [&](Index p) {
+              return volume_[group[p]] * strainEnergyDensity<D>(model, F_[group[p]]);
+            });
           },
           materials_[m]);
     }
@@ -170,9 +168,7 @@ class TlsphForces {
   }
 
   // K_I = sum_J k_IJ per particle: the penalty's spring stiffness (empty when it is off).
-  const std::vector<double>& hourglassStiffness() const {
-    return hourglassStiffness_;
-  }
+  const std::vector<double>& hourglassStiffness() const { return hourglassStiffness_; }
 
  private:
   // F_I = 1 + sum_J (u_J - u_I) (x) g_IJ (6.69), for the gradient vectors g given.
@@ -232,7 +228,7 @@ class TlsphForces {
     // and P^hg through the linear vectors).
     const std::vector<Mat<D>>& S = quadrature_ ? quadratureStress_
                                    : energyHourglass_ && !SeparateHourglassStress ? stress_
-                                                                                 : P_;
+                                                                                  : P_;
     const std::vector<Mat<D>>& Fh = separateHourglassGradient_ ? hourglassF_ : F_;
 #pragma omp parallel for schedule(static)
     for (Index i = 0; i < n; ++i) {
