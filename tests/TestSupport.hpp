@@ -54,7 +54,7 @@ class ForceEvaluator {
                                             Kernel<D>(scene_.kernel, scene_.supportRadius),
                                             scene_.periodicBox, scene_.gradientCorrection)),
         forces_(ref_, scene_.materials, scene_.particles.material, scene_.particles.volume,
-                scene_.hourglass()) {}
+                scene_.hourglass(), scene_.quadrature) {}
   ForceEvaluator(const ForceEvaluator&) = delete;
   ForceEvaluator& operator=(const ForceEvaluator&) = delete;
 

@@ -28,7 +28,7 @@ struct ViscousCase {
                                            scene.particles.volume,
                                            Kernel<D>(scene.kernel, scene.supportRadius))),
         forces(ref, scene.materials, scene.particles.material, scene.particles.volume,
-               HourglassSettings{}, q, 0.5 * scene.supportRadius) {}
+               HourglassSettings{}, Quadrature::Nodal, q, 0.5 * scene.supportRadius) {}
   static std::array<int, D> counts() {
     std::array<int, D> c;
     c.fill(D == 2 ? 6 : 4);

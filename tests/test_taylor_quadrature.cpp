@@ -26,7 +26,7 @@ Scene<D> blockScene(const std::string& material, double alpha, double jitter, st
   auto X = perturbedBlock<D>(counts, kDx, jitter, rng);
   Scene<D> scene = sceneOf<D>(X, kDx, 2.4, testMaterial(material), alpha);
   scene.gradientCorrection = GradientCorrection::Quadratic;
-  scene.taylorQuadrature = taylor;
+  scene.quadrature = taylor ? Quadrature::Taylor : Quadrature::Nodal;
   return scene;
 }
 
@@ -98,7 +98,7 @@ void expectTangentIsForceDifference(double alpha, std::uint32_t seed) {
   solver.reevaluate();
   DofMap<D> dofs(p, scene.mirrorGhosts);
   TangentStiffness<D> K(solver.reference(), scene.materials, p.material, p.volume,
-                        scene.hourglass(), dofs);
+                        scene.hourglass(), dofs, scene.quadrature);
   K.update(solver.forces().deformationGradient());
   K.updateQuadrature(solver.forces().quadrature(), solver.forces().deformationGradient());
   EXPECT_FALSE(K.assemblyExact());
@@ -189,7 +189,7 @@ void expectExactForQuadraticFields(std::uint32_t seed) {
     exact += w * density(X);
   }
   ForceEvaluator<D> corrected(scene);
-  scene.taylorQuadrature = false;
+  scene.quadrature = Quadrature::Nodal;
   ForceEvaluator<D> nodal(scene);
   EXPECT_TRUE(corrected.reference().linearFallback.empty());
   std::vector<Vec<D>> u(corrected.size());

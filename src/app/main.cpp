@@ -94,7 +94,8 @@ void printSetup(const SceneSetup<D>& setup, const Solver<D>& solver) {
             << ", H = " << setup.scene.supportRadius
             << " m = " << setup.scene.supportRadius / setup.dx << " dx, "
             << gradientCorrectionName(setup.scene.gradientCorrection) << " gradient correction, "
-            << (setup.scene.taylorQuadrature ? "Taylor-corrected" : "nodal") << " quadrature)\n"
+            << (setup.scene.quadrature == Quadrature::Taylor ? "Taylor-corrected" : "nodal")
+            << " quadrature)\n"
             << "hourglass    alpha = " << setup.scene.hourglassCoefficient
             << (setup.scene.hourglassCoefficient == 0
                     ? std::string(" (off)")

@@ -220,10 +220,12 @@ class Builder {
     setup_.scene.gradientCorrection =
         parseGradientCorrection(k.word("correction", "quadratic", {"linear", "quadratic"}));
     setup_.scene.supportRadius = ratio * setup_.dx;
-    // Issue 8: nodal = the one-point sum_I V_I psi(F_I); taylor adds its second-order
-    // correction (TaylorQuadrature.hpp; quadratic correction only).
-    setup_.scene.taylorQuadrature = k.word("quadrature", "nodal", {"nodal", "taylor"}) == "taylor";
-    if (setup_.scene.taylorQuadrature &&
+    // nodal = the one-point sum_I V_I psi(F_I); taylor adds its second-order term
+    // (TaylorQuadrature.hpp; quadratic correction only).
+    setup_.scene.quadrature = k.word("quadrature", "nodal", {"nodal", "taylor"}) == "taylor"
+                                  ? Quadrature::Taylor
+                                  : Quadrature::Nodal;
+    if (setup_.scene.quadrature == Quadrature::Taylor &&
         setup_.scene.gradientCorrection != GradientCorrection::Quadratic)
       throw k.error("quadrature",
                     "taylor needs correction = quadratic (its second derivatives come from the "

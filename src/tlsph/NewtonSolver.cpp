@@ -12,7 +12,7 @@ NewtonSolver<D>::NewtonSolver(Scene<D>& scene, Solver<D>& solver, const NewtonSe
       settings_(settings),
       dofs_(scene.particles, scene.mirrorGhosts),
       tangent_(solver.reference(), scene.materials, scene.particles.material,
-               scene.particles.volume, scene.hourglass(), dofs_) {
+               scene.particles.volume, scene.hourglass(), dofs_, scene.quadrature) {
   statistics_.linearSolver = SparseCholesky::name();
   if (!tangent_.assemblyExact())
     statistics_.linearSolver = "conjugate gradients preconditioned by " + statistics_.linearSolver;
@@ -191,7 +191,8 @@ bool NewtonSolver<D>::solveAt(double t, std::string& why) {
     // The exact tangent at the present state for the product; the factorised matrix, only a
     // preconditioner, is renewed when it has gone stale (too many conjugate-gradient iterations).
     tangent_.update(solver_.forces().deformationGradient());
-    tangent_.updateQuadrature(solver_.forces().quadrature(), solver_.forces().deformationGradient());
+    tangent_.updateQuadrature(solver_.forces().quadrature(),
+                              solver_.forces().deformationGradient());
     if (!factorised_ || lastKrylov_ > kRefactorAfter)
       if (!factorise(why)) return false;
     if (!solveLinear(r, du, why)) {

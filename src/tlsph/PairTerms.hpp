@@ -23,9 +23,6 @@ struct HourglassSettings {
   double alpha = 0.0;  // dimensionless; 0: no hourglass pass at all
   HourglassForm form = HourglassForm::Energy;
   HourglassGradient gradient = HourglassGradient::Corrected;
-  // Not a penalty: the second-order quadrature correction of the strain energy
-  // (TaylorQuadrature.hpp), carried here because it reaches every user of these settings.
-  bool taylorQuadrature = false;
   bool enabled() const { return alpha != 0.0; }
 };
 

@@ -18,6 +18,10 @@ namespace tlsph {
 //   particle's value; exact for quadratic fields, so also on free surfaces in bending, where
 //   the linear correction reads the strain at the neighbourhood's centroid, inside the body.
 enum class GradientCorrection { Linear, Quadratic };
+// How the strain energy is integrated over the particles ([kernel] quadrature): the one-point
+// nodal sum, or that sum with its second-order Taylor term (TaylorQuadrature.hpp; needs the
+// quadratic correction's fit).
+enum class Quadrature { Nodal, Taylor };
 
 const char* gradientCorrectionName(GradientCorrection c);
 GradientCorrection parseGradientCorrection(const std::string& name);  // invalid_argument

@@ -21,8 +21,8 @@ struct Scene {
   KernelType kernel = KernelType::WendlandC2;
   double supportRadius = 0.0;  // H = 2h
   GradientCorrection gradientCorrection = GradientCorrection::Linear;
-  bool taylorQuadrature = false;  // [kernel] quadrature = taylor (TaylorQuadrature.hpp)
-  double hourglassCoefficient = 0.0;  // alpha of (6.80); 0: no hourglass pass at all
+  Quadrature quadrature = Quadrature::Nodal;  // [kernel] quadrature
+  double hourglassCoefficient = 0.0;          // alpha of (6.80); 0: no hourglass pass at all
   HourglassForm hourglassForm = HourglassForm::Energy;
   HourglassGradient hourglassGradient = HourglassGradient::Corrected;
   ViscositySettings viscosity;  // artificial viscosity (6.77); off by default
@@ -35,7 +35,7 @@ struct Scene {
   Damping damping;
 
   HourglassSettings hourglass() const {
-    return {hourglassCoefficient, hourglassForm, hourglassGradient, taylorQuadrature};
+    return {hourglassCoefficient, hourglassForm, hourglassGradient};
   }
 };
 

@@ -64,7 +64,7 @@ class Solver {
                                             scene.particles.volume, checkedKernel(scene),
                                             scene.periodicBox, scene.gradientCorrection)),
         forces_(ref_, scene.materials, scene.particles.material, scene.particles.volume,
-                scene.hourglass(), scene.viscosity, 0.5 * scene.supportRadius,
+                scene.hourglass(), scene.quadrature, scene.viscosity, 0.5 * scene.supportRadius,
                 mirrorGhostList(scene)) {
     if (!(settings.cfl > 0.0)) throw SetupError("the CFL number must be positive");
     const auto& p = scene.particles;

@@ -41,10 +41,13 @@ class TangentStiffness {
   using Modulus = Eigen::Matrix<double, DD, DD>;  // dP/dF, index i + D j of (i, j)
   using SparseMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 
-  // The mirrored ghosts of `dofs` carry no strain energy of their own.
+  // The mirrored ghosts of `dofs` carry no strain energy of their own. With the Taylor
+  // quadrature, apply() includes its linearised term (updateQuadrature()); the assembly leaves
+  // it out, so assemblyExact() is false.
   TangentStiffness(const ReferenceConfiguration<D>& ref, const std::vector<Material>& materials,
                    const std::vector<std::uint16_t>& materialOf, const std::vector<double>& volume,
-                   const HourglassSettings& hourglass, const DofMap<D>& dofs)
+                   const HourglassSettings& hourglass, const DofMap<D>& dofs,
+                   Quadrature quadrature = Quadrature::Nodal)
       : ref_(ref),
         materials_(materials),
         volume_(volume),
@@ -81,9 +84,9 @@ class TangentStiffness {
       }
       penaltyStress_.assign(n_, Mat<D>::Zero());
     }
-    if (hourglass.taylorQuadrature) {
-      quadrature_ = std::make_unique<TaylorQuadrature<D>>(ref, materials, materialOf, volume,
-                                                          isPassive);
+    if (quadrature == Quadrature::Taylor) {
+      quadrature_ =
+          std::make_unique<TaylorQuadrature<D>>(ref, materials, materialOf, volume, isPassive);
       quadratureF_.assign(n_, Mat<D>::Identity());
       quadratureG_.assign(n_, typename TaylorQuadrature<D>::Gradients{});
       for (auto& g : quadratureG_)

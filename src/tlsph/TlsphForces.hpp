@@ -35,8 +35,8 @@ class TlsphForces {
   TlsphForces(const ReferenceConfiguration<D>& reference, const std::vector<Material>& materials,
               const std::vector<std::uint16_t>& materialOfParticle,
               const std::vector<double>& volume, const HourglassSettings& hourglass,
-              const ViscositySettings& viscosity = {}, double smoothingLength = 0.0,
-              const std::vector<Index>& passive = {})
+              Quadrature quadrature = Quadrature::Nodal, const ViscositySettings& viscosity = {},
+              double smoothingLength = 0.0, const std::vector<Index>& passive = {})
       : ref_(reference),
         materials_(materials),
         volume_(volume),
@@ -56,7 +56,7 @@ class TlsphForces {
       if (isPassive.empty() || !isPassive[i])
         particlesOfMaterial_.at(materialOfParticle[i]).push_back(i);
     passive_ = passive;
-    if (hourglass.taylorQuadrature) {
+    if (quadrature == Quadrature::Taylor) {
       quadrature_ = std::make_unique<TaylorQuadrature<D>>(reference, materials, materialOfParticle,
                                                           volume, isPassive);
       quadratureStress_.assign(n, Mat<D>::Zero());
