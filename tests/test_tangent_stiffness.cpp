@@ -7,6 +7,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "DifferencedStiffness.hpp"
 #include "TestSupport.hpp"
 #include "scene/SceneBuilder.hpp"
 #include "tlsph/DofMap.hpp"
@@ -122,27 +123,7 @@ Matrices<D> matricesOf(Scene<D>& scene, std::mt19937& rng) {
   const Eigen::SparseMatrix<double> full = K.assemble().template selfadjointView<Eigen::Lower>();
   m.assembled = Eigen::MatrixXd(full);
   // -df/du_k by central differences of the net force on the unknowns
-  const double h = 1e-6 * kDx;
-  m.differenced.resize(n, n);
-  const auto& free = dofs.freeParticles();
-  auto netForce = [&] {
-    Eigen::VectorXd f(n);
-    for (std::size_t d = 0; d < free.size(); ++d)
-      f.template segment<D>(D * d) = solver.netForce(free[d]);
-    return f;
-  };
-  for (Index k = 0; k < n; ++k) {
-    Vec<D>& u = p.displacement[free[k / D]];
-    u[k % D] += h;
-    solver.reevaluate();
-    const Eigen::VectorXd plus = netForce();
-    u[k % D] -= 2.0 * h;
-    solver.reevaluate();
-    const Eigen::VectorXd minus = netForce();
-    u[k % D] += h;
-    m.differenced.col(k) = -(plus - minus) / (2.0 * h);
-  }
-  solver.reevaluate();
+  m.differenced = differencedStiffness(solver, p.displacement, dofs.freeParticles(), 1e-6 * kDx);
   return m;
 }
 

@@ -24,23 +24,6 @@ GradientCorrection parseGradientCorrection(const std::string& name) {
 
 namespace {
 
-// Monomials of a quadratic fit through the particle's own value, in d = Delta / H:
-// d_1..d_D, then d_a d_b for a <= b.
-template <int D>
-constexpr int kQuadraticTerms = D + D*(D + 1) / 2;
-
-template <int D>
-Eigen::Matrix<double, kQuadraticTerms<D>, 1> quadraticBasis(const Vec<D>& d) {
-  Eigen::Matrix<double, kQuadraticTerms<D>, 1> p;
-  int t = 0;
-  for (int a = 0; a < D; ++a)
-    p[t++] = d[a];
-  for (int a = 0; a < D; ++a)
-    for (int b = a; b < D; ++b)
-      p[t++] = d[a] * d[b];
-  return p;
-}
-
 std::string conditionMessage(Index i, const std::string& position, Index neighbours,
                              const char* what, double condition, double needed, int D) {
   std::ostringstream msg;

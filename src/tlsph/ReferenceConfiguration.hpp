@@ -18,6 +18,23 @@ namespace tlsph {
 //   particle's value; exact for quadratic fields, so also on free surfaces in bending, where
 //   the linear correction reads the strain at the neighbourhood's centroid, inside the body.
 enum class GradientCorrection { Linear, Quadratic };
+
+// Monomials of the quadratic correction's fit through the particle's own value, in a scaled
+// offset d: d_1..d_D, then d_a d_b for a <= b (also TaylorQuadrature's second derivatives).
+template <int D>
+constexpr int kQuadraticTerms = D + D*(D + 1) / 2;
+
+template <int D>
+Eigen::Matrix<double, kQuadraticTerms<D>, 1> quadraticBasis(const Vec<D>& d) {
+  Eigen::Matrix<double, kQuadraticTerms<D>, 1> p;
+  int t = 0;
+  for (int a = 0; a < D; ++a)
+    p[t++] = d[a];
+  for (int a = 0; a < D; ++a)
+    for (int b = a; b < D; ++b)
+      p[t++] = d[a] * d[b];
+  return p;
+}
 // How the strain energy is integrated over the particles ([kernel] quadrature): the one-point
 // nodal sum, or that sum with its second-order Taylor term (TaylorQuadrature.hpp; needs the
 // quadratic correction's fit).

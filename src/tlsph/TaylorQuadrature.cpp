@@ -22,7 +22,7 @@ TaylorQuadrature<D>::TaylorQuadrature(const ReferenceConfiguration<D>& ref,
   std::vector<std::uint8_t> fallback(n, 0);
   for (Index i : ref.linearFallback)
     fallback[i] = 1;
-  constexpr int T = D + D * (D + 1) / 2;
+  constexpr int T = kQuadraticTerms<D>;
   using Moment = Eigen::Matrix<double, T, T>;
   using Basis = Eigen::Matrix<double, T, 1>;
   for (Index i = 0; i < n; ++i) {
@@ -37,17 +37,7 @@ TaylorQuadrature<D>::TaylorQuadrature(const ReferenceConfiguration<D>& ref,
     if (ref.correction != GradientCorrection::Quadratic || fallback[i]) continue;
     // The fit of ReferenceConfiguration (scale-free: the basis is scaled by l for conditioning).
     const double l = std::pow(volume[i], 1.0 / D);
-    auto basis = [&](Index k) {
-      const Vec<D> d = -ref.separation[k] / l;
-      Basis p;
-      int t = 0;
-      for (int a = 0; a < D; ++a)
-        p[t++] = d[a];
-      for (int a = 0; a < D; ++a)
-        for (int b = a; b < D; ++b)
-          p[t++] = d[a] * d[b];
-      return p;
-    };
+    auto basis = [&](Index k) -> Basis { return quadraticBasis<D>(-ref.separation[k] / l); };
     Moment M = Moment::Zero();
     for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
       const Basis p = basis(k);
