@@ -16,7 +16,8 @@ using namespace tlsph;
 int main(int argc, char** argv) {
   double dx = 0.0125, supportRatio = 2.1, alpha = 10.0;
   long steps = 200;
-  std::string material = "neo-hookean", correction = "linear", form = "energy";
+  std::string material = "neo-hookean", correction = "linear", form = "energy",
+              quadrature = "nodal";
   po::options_description options("tlsph_bench: 3D cantilever throughput");
   options.add_options()("help", "this help")("dx", po::value(&dx)->default_value(dx),
                                              "particle spacing [m] (0.0125: 80 x 8 x 8)")(
@@ -27,7 +28,9 @@ int main(int argc, char** argv) {
       "steps", po::value(&steps)->default_value(steps), "time steps to time")(
       "correction", po::value(&correction)->default_value(correction),
       "gradient correction: linear or quadratic")("form", po::value(&form)->default_value(form),
-                                                  "hourglass form: energy or ganzenmueller");
+                                                  "hourglass form: energy or ganzenmueller")(
+      "quadrature", po::value(&quadrature)->default_value(quadrature),
+      "strain-energy quadrature: nodal or taylor (taylor needs the quadratic correction)");
   po::variables_map vm;
   po::store(po::parse_command_line(argc, argv, options), vm);
   po::notify(vm);
@@ -43,6 +46,7 @@ int main(int argc, char** argv) {
   scene.hourglassCoefficient = alpha;
   scene.hourglassForm = parseHourglassForm(form);
   scene.gradientCorrection = parseGradientCorrection(correction);
+  scene.quadrature = parseQuadrature(quadrature);
   scene.gravity = Vec3(0, 0, -1.0);
   const int nx = static_cast<int>(std::lround(1.0 / dx));
   const int ny = static_cast<int>(std::lround(0.1 / dx));
@@ -59,7 +63,7 @@ int main(int argc, char** argv) {
   std::cout << "particles " << scene.particles.size() << " (" << nx * ny * ny << " body), "
             << "mean neighbours " << double(nb.pairCount()) / nb.particleCount() << ", threads "
             << omp_get_max_threads() << ", dt " << solver.timeStep() << ", " << correction
-            << " correction, hourglass " << form << "\n";
+            << " correction, " << quadrature << " quadrature, hourglass " << form << "\n";
   solver.step();  // warm-up
   const auto start = std::chrono::steady_clock::now();
   for (long s = 0; s < steps; ++s)

@@ -191,7 +191,8 @@ void expectExactForQuadraticFields(std::uint32_t seed) {
     const Mat<D> H = gradient(X);
     EXPECT_LT((corrected.forces().deformationGradient()[i] - Mat<D>::Identity() - H).norm(),
               1e-8 * A.norm());
-    const auto G = corrected.forces().quadrature()->secondGradients()[i];
+    const auto G =
+        TaylorQuadrature<D>::unpack(corrected.forces().quadrature()->secondGradients()[i]);
     for (int a = 0; a < D; ++a)
       for (int k = 0; k < D; ++k)
         EXPECT_LT((G[a].row(k) - B[k].row(a)).norm(), 1e-8 * B[k].norm()) << i << " " << a;

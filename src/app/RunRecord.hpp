@@ -75,7 +75,7 @@ void writeRunRecord(const std::filesystem::path& file, const SceneSetup<D>& setu
   field("support_over_dx", jsonNumber(setup.scene.supportRadius / setup.dx));
   field("kernel", jsonText(std::string(kernelName(setup.scene.kernel))));
   field("gradient_correction", jsonText(gradientCorrectionName(setup.scene.gradientCorrection)));
-  field("quadrature", jsonText(setup.scene.quadrature == Quadrature::Taylor ? "taylor" : "nodal"));
+  field("quadrature", jsonText(quadratureName(setup.scene.quadrature)));
   field("hourglass_alpha", jsonNumber(setup.scene.hourglassCoefficient));
   field("hourglass_form", jsonText(hourglassFormName(setup.scene.hourglassForm)));
   field("hourglass_gradient", jsonText(hourglassGradientName(setup.scene.hourglassGradient)));

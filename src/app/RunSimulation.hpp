@@ -100,7 +100,7 @@ std::vector<double> probeRow(const SceneSetup<D>& setup, const Solver<D>& solver
         // u to second order, + 1/2 d . grad grad u_J d (issue 8: the first-order carry reads a
         // plate's centre deflection 0.4 % high at 4 through, by 1/2 |w''| <d^2>).
         if (firstOrder && quadrature) {
-          const auto& G = quadrature->secondGradients()[j];
+          const auto G = TaylorQuadrature<D>::unpack(quadrature->secondGradients()[j]);
           for (int a = 0; a < D; ++a)
             u += 0.5 * probe.offsets[k][a] * (G[a] * probe.offsets[k]);
         }

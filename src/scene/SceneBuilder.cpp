@@ -222,9 +222,7 @@ class Builder {
     setup_.scene.supportRadius = ratio * setup_.dx;
     // nodal = the one-point sum_I V_I psi(F_I); taylor adds its second-order term
     // (TaylorQuadrature.hpp; quadratic correction only).
-    setup_.scene.quadrature = k.word("quadrature", "nodal", {"nodal", "taylor"}) == "taylor"
-                                  ? Quadrature::Taylor
-                                  : Quadrature::Nodal;
+    setup_.scene.quadrature = parseQuadrature(k.word("quadrature", "nodal", {"nodal", "taylor"}));
     if (setup_.scene.quadrature == Quadrature::Taylor &&
         setup_.scene.gradientCorrection != GradientCorrection::Quadratic)
       throw k.error("quadrature",

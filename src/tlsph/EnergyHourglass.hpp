@@ -63,8 +63,13 @@ class EnergyHourglass {
       const Mat<D> Hi = Gradient ? F[i] : Mat<D>(F[i] - Mat<D>::Identity());
       sum -= 0.5 * (Hi * sumCX_[i]);                // sum_J c_IJ e_IJ
       moment.noalias() -= 0.5 * (Hi * sumCXX_[i]);  // sum_J c_IJ e_IJ (x) X_IJ
-      stress[i] = P ? Mat<D>((*P)[i] - 0.5 * moment) : Mat<D>(-0.5 * moment);  // P + P^hg
-      spring_[i] = -volume_[i] * sum;                                          // -sum_J k_IJ e_IJ
+      // P + P^hg, written as expressions: a Mat = Mat copy here is an out-of-line call once
+      // the unit holds enough of them, and that spills the loop's sums to memory
+      if (P)
+        stress[i].noalias() = (*P)[i] - 0.5 * moment;
+      else
+        stress[i].noalias() = -0.5 * moment;
+      spring_[i] = -volume_[i] * sum;  // -sum_J k_IJ e_IJ
     }
   }
 

@@ -22,6 +22,16 @@ GradientCorrection parseGradientCorrection(const std::string& name) {
                               "'; expected linear or quadratic");
 }
 
+const char* quadratureName(Quadrature q) {
+  return q == Quadrature::Nodal ? "nodal" : "taylor";
+}
+
+Quadrature parseQuadrature(const std::string& name) {
+  if (name == "nodal") return Quadrature::Nodal;
+  if (name == "taylor") return Quadrature::Taylor;
+  throw std::invalid_argument("unknown quadrature '" + name + "'; expected nodal or taylor");
+}
+
 namespace {
 
 std::string conditionMessage(Index i, const std::string& position, Index neighbours,

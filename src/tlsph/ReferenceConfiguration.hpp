@@ -42,6 +42,8 @@ enum class Quadrature { Nodal, Taylor };
 
 const char* gradientCorrectionName(GradientCorrection c);
 GradientCorrection parseGradientCorrection(const std::string& name);  // invalid_argument
+const char* quadratureName(Quadrature q);
+Quadrature parseQuadrature(const std::string& name);  // invalid_argument
 
 template <int D>
 struct ReferenceConfiguration {

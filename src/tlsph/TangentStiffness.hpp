@@ -88,10 +88,7 @@ class TangentStiffness {
       quadrature_ =
           std::make_unique<TaylorQuadrature<D>>(ref, materials, materialOf, volume, isPassive);
       quadratureF_.assign(n_, Mat<D>::Identity());
-      quadratureG_.assign(n_, typename TaylorQuadrature<D>::Gradients{});
-      for (auto& g : quadratureG_)
-        for (auto& m : g)
-          m.setZero();
+      quadratureG_.assign(n_, TaylorQuadrature<D>::SymMatrix::Zero());
     }
     full_.assign(n_, Vec<D>::Zero());
     dF_.assign(n_, Mat<D>::Zero());
@@ -169,7 +166,7 @@ class TangentStiffness {
   std::unique_ptr<EnergyHourglass<D>> penalty_;
   std::unique_ptr<TaylorQuadrature<D>> quadrature_;
   std::vector<Mat<D>> quadratureF_;
-  std::vector<typename TaylorQuadrature<D>::Gradients> quadratureG_;
+  std::vector<typename TaylorQuadrature<D>::SymMatrix> quadratureG_;
   bool separate_ = false;  // the penalty compares with the linear F (its own vectors)
   std::vector<Vec<D>> linearReverse_, linearSum_;
   std::vector<Mat<D>> hourglassH_, penaltyStress_;

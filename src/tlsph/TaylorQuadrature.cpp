@@ -1,6 +1,11 @@
 // TaylorQuadrature's set-up (see the header), compiled once for 2D and 3D: the fit's moment
 // matrices are inverted here (Eigen's dense eigensolver), out of every file that includes the
 // force pass.
+// Eigen's small products inlined in the per-particle part of the force pass (stressAt), as in
+// TlsphForces.cpp.
+#ifndef EIGEN_STRONG_INLINE
+#define EIGEN_STRONG_INLINE inline __attribute__((always_inline))
+#endif
 #include "tlsph/TaylorQuadrature.hpp"
 
 namespace tlsph {
@@ -70,10 +75,7 @@ TaylorQuadrature<D>::TaylorQuadrature(const ReferenceConfiguration<D>& ref,
       if (at != last && *at == i)
         reverse_[k] = (volume[j] / volume[i]) * S_[at - nb.neighbour.begin()];
     }
-  G_.assign(n, Gradients{});
-  for (auto& g : G_)
-    for (auto& m : g)
-      m.setZero();
+  G_.assign(n, SymMatrix::Zero());
   R_.assign(n, SymMatrix::Zero());
   force_.assign(n, Vec<D>::Zero());
 }

@@ -56,6 +56,11 @@ class TaylorQuadrature {
     const Vec<D> ui = u[i];
     for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k)
       Gs.noalias() += (u[nb.neighbour[k]] - ui) * S_[k].transpose();
+    return unpack(Gs);
+  }
+
+  // G_a(:, b) = G_b(:, a) = column (a, b) of the symmetric storage.
+  static Gradients unpack(const SymMatrix& Gs) {
     Gradients G;
     int t = 0;
     for (int a = 0; a < D; ++a)
@@ -66,35 +71,34 @@ class TaylorQuadrature {
     return G;
   }
 
-  // stress[i] += P^q_i (stress holds what the force pass sends through g_IJ) and the
-  // hyperstress force on every particle, for displacements u and deformation gradients F.
-  void evaluate(const std::vector<Vec<D>>& u, const std::vector<Mat<D>>& F,
-                std::vector<Mat<D>>& stress) {
-    const Index n = ref_.particleCount();
-#pragma omp parallel for schedule(static)
-    for (Index i = 0; i < n; ++i) {
-      if (weight_[i] == 0.0) {
-        R_[i].setZero();
-        continue;
-      }
-      G_[i] = secondGradients(i, u);
-      Mat<D> Pq = Mat<D>::Zero();
-      Gradients R;
-      for (int a = 0; a < D; ++a) {
-        const Mat<D> sigma = weight_[i] * stressOf(i, F[i].transpose() * G_[i][a]);
-        Pq.noalias() += G_[i][a] * sigma;
-        R[a] = F[i] * sigma;
-      }
-      R_[i] = symmetric(R);
-      stress[i] += Pq;
-    }
-    hyperForce(R_);
+  // The force pass's parts, fused into TlsphForces' loops (one pass over the pairs each):
+  // in the F loop, Gs += (u_J - u_I) (x) S_IJ beside F (gather), then stressAt(i, F_I, Gs) =
+  // P^q_I, added to the stress sent through g_IJ, which also keeps G_I and the hyperstress
+  // R_I; in the force loop, f_I += V_I (R_I . Sum_I - sum_J R_J . T_IJ) (hyperForce*).
+  void gather(Index k, const Vec<D>& du, SymMatrix& Gs) const {
+    Gs.noalias() += du * S_[k].transpose();
   }
+  Mat<D> stressAt(Index i, const Mat<D>& F, const SymMatrix& Gs) {
+    if (weight_[i] == 0.0) return Mat<D>::Zero();  // R_i stays zero
+    G_[i] = Gs;
+    const Gradients A = unpack(F.transpose() * Gs);  // F^T G_a
+    const Gradients G = unpack(Gs);
+    Gradients sigma;
+    Mat<D> Pq = Mat<D>::Zero();
+    for (int a = 0; a < D; ++a) {
+      sigma[a] = weight_[i] * stressOf(i, A[a]);
+      Pq.noalias() += G[a] * sigma[a];
+    }
+    R_[i].noalias() = F * symmetric(sigma);  // R_a = F sigma_a, stored symmetric
+    return Pq;
+  }
+  Vec<D> hyperForceOwn(Index i) const { return R_[i] * sum_[i]; }
+  Vec<D> hyperForcePair(Index k, Index j) const { return R_[j] * reverse_[k]; }
 
   // Linearised: dstress[i] += dP^q_i and the linearised hyperstress force, for the direction v
-  // (with dF its displacement gradient) about the state (F, G) of the last evaluate().
+  // (with dH its displacement gradient) about the state (F, G) of a force pass.
   void linearise(const std::vector<Vec<D>>& v, const std::vector<Mat<D>>& dH,
-                 const std::vector<Mat<D>>& F, const std::vector<Gradients>& G,
+                 const std::vector<Mat<D>>& F, const std::vector<SymMatrix>& Gs,
                  std::vector<Mat<D>>& dstress) {
     const Index n = ref_.particleCount();
 #pragma omp parallel for schedule(static)
@@ -104,13 +108,14 @@ class TaylorQuadrature {
         continue;
       }
       const Gradients dG = secondGradients(i, v);
+      const Gradients G = unpack(Gs[i]);
       Mat<D> dPq = Mat<D>::Zero();
       Gradients R;
       for (int a = 0; a < D; ++a) {
-        const Mat<D> sigma = weight_[i] * stressOf(i, F[i].transpose() * G[i][a]);
+        const Mat<D> sigma = weight_[i] * stressOf(i, F[i].transpose() * G[a]);
         const Mat<D> dsigma =
-            weight_[i] * stressOf(i, dH[i].transpose() * G[i][a] + F[i].transpose() * dG[a]);
-        dPq.noalias() += dG[a] * sigma + G[i][a] * dsigma;
+            weight_[i] * stressOf(i, dH[i].transpose() * G[a] + F[i].transpose() * dG[a]);
+        dPq.noalias() += dG[a] * sigma + G[a] * dsigma;
         R[a] = dH[i] * sigma + F[i] * dsigma;
       }
       R_[i] = symmetric(R);
@@ -119,20 +124,23 @@ class TaylorQuadrature {
     hyperForce(R_);
   }
 
+  // The linearised hyperstress force on particle i from the last linearise().
   const Vec<D>& force(Index i) const {
     return force_[i];
   }
-  const std::vector<Gradients>& secondGradients() const {
+  // grad grad u of every particle at the last force pass, in the symmetric storage (unpack()).
+  const std::vector<SymMatrix>& secondGradients() const {
     return G_;
   }
 
-  // E_q at the state of the last evaluate().
+  // E_q at the state of the last force pass.
   double energy(const std::vector<Mat<D>>& F) const {
     return orderedSum(ref_.particleCount(), [&](Index i) {
       if (weight_[i] == 0.0) return 0.0;
       double e = 0.0;
+      const Gradients G = unpack(G_[i]);
       for (int a = 0; a < D; ++a) {
-        const Mat<D> ea = F[i].transpose() * G_[i][a];
+        const Mat<D> ea = F[i].transpose() * G[a];
         e += (stressOf(i, ea).array() * (0.5 * (ea + ea.transpose())).array()).sum();
       }
       return 0.5 * volume_[i] * weight_[i] * e;  // V l^2 / 24 sum_a e_a : C0 : e_a
@@ -173,7 +181,7 @@ class TaylorQuadrature {
   const std::vector<double>& volume_;
   std::vector<Sym> S_, reverse_, sum_;  // S_IJ, T_IJ = (V_J / V_I) S_JI, sum_J S_IJ
   std::vector<double> weight_, lambda_, mu_;
-  std::vector<Gradients> G_;
+  std::vector<SymMatrix> G_;  // grad grad u, symmetric storage
   std::vector<SymMatrix> R_;  // hyperstress, symmetric storage
   std::vector<Vec<D>> force_;
 };

@@ -100,33 +100,19 @@ class TlsphForces {
   // artificial viscosity.
   void compute(const std::vector<Vec<D>>& u, std::vector<Vec<D>>& f,
                const std::vector<Vec<D>>* v = nullptr) {
-    for (std::size_t m = 0; m < materials_.size(); ++m)
-      std::visit(
-          [&](const auto& model) { deformationAndStress(&model, particlesOfMaterial_[m], u); },
-          materials_[m]);
-    // Passive particles (mirrored ghosts): F for the penalty and the output, P stays zero.
-    if (!passive_.empty()) deformationAndStress<void>(nullptr, passive_, u);
-    const bool viscous = viscosity_ && v != nullptr;
-    if (energyHourglass_ && separateHourglassGradient_) {
-      // P^hg of the linear F goes through the linear gradient vectors: its own sum.
+    quadrature_ ? stressPass<true>(u) : stressPass<false>(u);
+    // What the force pass sends through g_IJ: P (+ P^q) (+ P^hg of the same F).
+    const std::vector<Mat<D>>& PQ = quadrature_ ? quadratureStress_ : P_;
+    // P^hg of the linear F goes through the linear gradient vectors: its own sum.
+    if (energyHourglass_ && separateHourglassGradient_)
       energyHourglass_->evaluate(u, hourglassF_, nullptr, stress_);
-      if (quadrature_) {
-        quadratureStress_ = P_;
-        quadrature_->evaluate(u, F_, quadratureStress_);
-      }
-      viscous ? accumulateForces<false, true, true>(u, f, v)
-              : accumulateForces<false, false, true>(u, f, v);
-      return;
-    }
-    if (energyHourglass_) energyHourglass_->evaluate(u, F_, &P_, stress_);
-    if (quadrature_) {
-      quadratureStress_ = energyHourglass_ ? stress_ : P_;
-      quadrature_->evaluate(u, F_, quadratureStress_);
-    }
-    if (ganzenmueller_)
-      viscous ? accumulateForces<true, true>(u, f, v) : accumulateForces<true, false>(u, f, v);
+    else if (energyHourglass_)
+      energyHourglass_->evaluate(u, F_, &PQ, stress_);
+    const bool viscous = viscosity_ && v != nullptr;
+    if (quadrature_)
+      forcePass<true>(u, f, v, viscous);
     else
-      viscous ? accumulateForces<false, true>(u, f, v) : accumulateForces<false, false>(u, f, v);
+      forcePass<false>(u, f, v, viscous);
   }
 
   const std::vector<Mat<D>>& deformationGradient() const { return F_; }
@@ -182,24 +168,49 @@ class TlsphForces {
     return Mat<D>::Identity() + gradU;
   }
 
+  // F and P of every particle (F only for the passive ones), with the quadrature's second
+  // gradients in the same pass when Taylor.
+  template <bool Taylor>
+  void stressPass(const std::vector<Vec<D>>& u) {
+    for (std::size_t m = 0; m < materials_.size(); ++m)
+      std::visit(
+          [&](const auto& model) {
+            deformationAndStress<std::decay_t<decltype(model)>, Taylor>(&model,
+                                                                        particlesOfMaterial_[m], u);
+          },
+          materials_[m]);
+    // Passive particles (mirrored ghosts): F for the penalty and the output, P stays zero.
+    if (!passive_.empty()) deformationAndStress<void, false>(nullptr, passive_, u);
+  }
+
   // F (and the penalty's own linear F where it has one) of the particles in group; their
-  // stress P unless Model is void (the passive particles).
-  template <class Model>
+  // stress P unless Model is void (the passive particles); with Taylor, P + P^q as well.
+  template <class Model, bool Taylor>
   void deformationAndStress(const Model* model, const std::vector<Index>& group,
                             const std::vector<Vec<D>>& u) {
     const auto& nb = ref_.neighbours;
     const Index count = static_cast<Index>(group.size());
+    [[maybe_unused]] TaylorQuadrature<D>* q = quadrature_.get();
 #pragma omp parallel for schedule(static)
     for (Index p = 0; p < count; ++p) {
       const Index i = group[p];
       // deformationGradientOf written out: the hot loop measured 2-3 % slower through the call
       const Vec<D> ui = u[i];
       Mat<D> gradU = Mat<D>::Zero();
-      for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k)
-        gradU.noalias() += (u[nb.neighbour[k]] - ui) * ref_.correctedGradient[k].transpose();
+      [[maybe_unused]] typename TaylorQuadrature<D>::SymMatrix Gs;
+      if constexpr (Taylor) Gs.setZero();
+      for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
+        const Vec<D> du = u[nb.neighbour[k]] - ui;
+        gradU.noalias() += du * ref_.correctedGradient[k].transpose();
+        if constexpr (Taylor) q->gather(k, du, Gs);  // grad grad u, beside F
+      }
       const Mat<D> F = Mat<D>::Identity() + gradU;  // (6.69)
       F_[i] = F;
-      if constexpr (!std::is_void_v<Model>) P_[i] = firstPiolaKirchhoff<D>(*model, F);
+      if constexpr (!std::is_void_v<Model>) {
+        const Mat<D> P = firstPiolaKirchhoff<D>(*model, F);
+        P_[i] = P;
+        if constexpr (Taylor) quadratureStress_[i] = P + q->stressAt(i, F, Gs);
+      }
     }
     if (separateHourglassGradient_) {
 #pragma omp parallel for schedule(static)
@@ -219,17 +230,33 @@ class TlsphForces {
         linearSum_[i] += ref_.linearGradient[k];
   }
 
-  template <bool Ganzenmueller, bool Viscous, bool SeparateHourglassStress = false>
+  // The force pass instantiated for the terms in use.
+  template <bool Taylor>
+  void forcePass(const std::vector<Vec<D>>& u, std::vector<Vec<D>>& f, const std::vector<Vec<D>>* v,
+                 bool viscous) {
+    if (energyHourglass_ && separateHourglassGradient_)
+      viscous ? accumulateForces<false, true, true, Taylor>(u, f, v)
+              : accumulateForces<false, false, true, Taylor>(u, f, v);
+    else if (ganzenmueller_)
+      viscous ? accumulateForces<true, true, false, Taylor>(u, f, v)
+              : accumulateForces<true, false, false, Taylor>(u, f, v);
+    else
+      viscous ? accumulateForces<false, true, false, Taylor>(u, f, v)
+              : accumulateForces<false, false, false, Taylor>(u, f, v);
+  }
+
+  template <bool Ganzenmueller, bool Viscous, bool SeparateHourglassStress, bool Taylor>
   void accumulateForces(const std::vector<Vec<D>>& u, std::vector<Vec<D>>& f,
                         const std::vector<Vec<D>>* velocity) {
     const auto& nb = ref_.neighbours;
     const Index n = ref_.particleCount();
-    // The stress the force pass sends through the gradient vectors: P, or P + P^hg (or P,
-    // and P^hg through the linear vectors).
-    const std::vector<Mat<D>>& S = quadrature_ ? quadratureStress_
-                                   : energyHourglass_ && !SeparateHourglassStress ? stress_
-                                                                                  : P_;
+    // The stress the force pass sends through the gradient vectors: P (+ P^q), or that plus
+    // P^hg (or P^hg alone through the linear vectors).
+    const std::vector<Mat<D>>& S = energyHourglass_ && !SeparateHourglassStress ? stress_
+                                   : Taylor                                     ? quadratureStress_
+                                                                                : P_;
     const std::vector<Mat<D>>& Fh = separateHourglassGradient_ ? hourglassF_ : F_;
+    [[maybe_unused]] const TaylorQuadrature<D>* q = quadrature_.get();
 #pragma omp parallel for schedule(static)
     for (Index i = 0; i < n; ++i) {
       // (6.70) as a force: f_I = V_I (S_I G_I - sum_J S_J t_IJ)
@@ -237,10 +264,12 @@ class TlsphForces {
       Vec<D> hourglass = Vec<D>::Zero(), viscous = Vec<D>::Zero();
       const Vec<D> ui = u[i];
       if constexpr (SeparateHourglassStress) internal += stress_[i] * linearSum_[i];
+      if constexpr (Taylor) internal += q->hyperForceOwn(i);  // through grad grad u
       for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
         const Index j = nb.neighbour[k];
         internal.noalias() -= S[j] * ref_.reverseGradient[k];
         if constexpr (SeparateHourglassStress) internal.noalias() -= stress_[j] * linearReverse_[k];
+        if constexpr (Taylor) internal.noalias() -= q->hyperForcePair(k, j);
         if constexpr (Ganzenmueller || Viscous) {
           const Vec<D>& Xij = ref_.separation[k];
           const Vec<D> xij = Xij + (ui - u[j]);
@@ -251,7 +280,6 @@ class TlsphForces {
       }
       Vec<D> total = volume_[i] * internal;
       if (energyHourglass_) total += energyHourglass_->springForce(i);
-      if (quadrature_) total += quadrature_->force(i);
       if constexpr (Ganzenmueller) {
         hourglassForce_[i] = volume_[i] * hourglass;
         total += hourglassForce_[i];
@@ -279,11 +307,14 @@ class TlsphForces {
   std::vector<double> hourglassStiffness_;  // K_I
   std::unique_ptr<EnergyHourglass<D>> energyHourglass_;
   std::unique_ptr<TaylorQuadrature<D>> quadrature_;
-  std::vector<Mat<D>> quadratureStress_;  // the force pass's stress plus P^q
+  std::vector<Mat<D>> quadratureStress_;  // P + P^q
   std::unique_ptr<GanzenmuellerHourglass<D>> ganzenmueller_;
   std::unique_ptr<ArtificialViscosity<D>> viscosity_;
   std::vector<Vec<D>> hourglassForce_;
   std::vector<Vec<D>> viscousForce_;
 };
+
+extern template class TlsphForces<2>;
+extern template class TlsphForces<3>;
 
 }  // namespace tlsph
