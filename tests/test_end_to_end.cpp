@@ -74,7 +74,8 @@ TEST_F(EndToEnd, CantileverConvergesOnTimoshenkoDeflection) {
   const double tip = -row.at("tip_uz");
   // Converged CalculiX C3D20R of the same beam, face x = 0 clamped (validation/fem/
   // references.json, Richardson of 10x1x1 .. 80x8x8); tlsph at this resolution (8 through)
-  // measured +1.6 % (validation/report), converging at order 1.8-1.9.
+  // measured +1.58 % (validation/report), converging at order 1.8-1.9: the nodal energy sum's
+  // 1/n^2 bending deficit (validation/quadrature_study.md; -0.12 % with quadrature = taylor).
   const double timoshenko = 0.01516, fem = 0.015022;
   std::cout << "cantilever tip deflection " << tip << " m (Timoshenko " << timoshenko << ", FEM "
             << fem << "): " << 100 * (tip - fem) / fem << " % against the FEM\n";

@@ -298,3 +298,19 @@ TEST(SceneInput, RandomInitialVelocityIsSeededAndBounded) {
   EXPECT_LT(std::abs(mean / a.size()), 0.1);
   EXPECT_THROW(velocities("seed = 1\n", "0"), InputError);
 }
+
+// The Taylor quadrature warns (naming the material) on a nearly incompressible material, where
+// its volumetric term stiffens coarse resolutions; not on a compressible one, not when nodal.
+TEST(SceneInput, TaylorQuadratureWarnsOnNearlyIncompressibleMaterial) {
+  auto warningsOf = [](const std::string& text) {
+    return buildScene<2>(Config::parse(text, "scene.ini")).warnings;
+  };
+  const std::string taylor = kGood + std::string("[kernel]\nquadrature = taylor\n");
+  EXPECT_TRUE(warningsOf(taylor).empty());
+  const auto w = warningsOf(replaced(taylor, "poisson_ratio = 0.3", "poisson_ratio = 0.49"));
+  ASSERT_EQ(w.size(), 1u);
+  for (const char* part :
+       {"scene.ini", "poisson_ratio 0.49", "quadrature = taylor", "quadrature = nodal"})
+    EXPECT_NE(w[0].find(part), std::string::npos) << part << " in " << w[0];
+  EXPECT_TRUE(warningsOf(replaced(kGood, "poisson_ratio = 0.3", "poisson_ratio = 0.49")).empty());
+}

@@ -236,7 +236,7 @@ alpha = 0
     Solver<3> solver(scene);
     DofMap<3> dofs(scene.particles, scene.mirrorGhosts);
     TangentStiffness<3> K(solver.reference(), scene.materials, scene.particles.material,
-                          scene.particles.volume, scene.hourglass(), dofs);
+                          scene.particles.volume, scene.hourglass(), dofs, scene.quadrature);
     std::mt19937 rng(5);
     const auto& free = dofs.freeParticles();
     for (int state = 0; state < 2; ++state) {
@@ -245,6 +245,7 @@ alpha = 0
           scene.particles.displacement[i] = randomVector<3>(rng, 1e-4);
       solver.reevaluate();
       K.update(solver.forces().deformationGradient());
+      K.updateQuadrature(solver.forces().quadrature(), solver.forces().deformationGradient());
       auto netForce = [&] {
         Eigen::VectorXd f(3 * free.size());
         for (std::size_t d = 0; d < free.size(); ++d)

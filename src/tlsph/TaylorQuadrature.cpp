@@ -24,6 +24,7 @@ TaylorQuadrature<D>::TaylorQuadrature(const ReferenceConfiguration<D>& ref,
   weight_.assign(n, 0.0);
   lambda_.assign(n, 0.0);
   mu_.assign(n, 0.0);
+  smallStrain_.assign(n, 0);
   std::vector<std::uint8_t> fallback(n, 0);
   for (Index i : ref.linearFallback)
     fallback[i] = 1;
@@ -38,6 +39,7 @@ TaylorQuadrature<D>::TaylorQuadrature(const ReferenceConfiguration<D>& ref,
       weight_[i] = l * l / 12.0;
       lambda_[i] = c.lambda;
       mu_[i] = c.mu;
+      smallStrain_[i] = std::holds_alternative<LinearElastic>(materials[materialOf[i]]);
     }
     if (ref.correction != GradientCorrection::Quadratic || fallback[i]) continue;
     // The fit of ReferenceConfiguration (scale-free: the basis is scaled by l for conditioning).

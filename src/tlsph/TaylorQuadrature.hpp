@@ -11,7 +11,9 @@
 // derivatives of u from the same weighted least-squares quadratic fit that gives F
 // (ReferenceConfiguration, quadratic correction): grad grad u_I = sum_J (u_J - u_I) (x) S_IJ.
 // e_a is objective (F -> R F, dF -> R dF leave F^T dF unchanged) and zero for every affine
-// displacement (rigid rotations included); E_q >= 0.
+// displacement (rigid rotations included); E_q >= 0. For the linear-elastic material, whose
+// energy is that of the small strain, e_a = sym(dF/dX_a) (F -> 1 below, and no P^q): the term
+// is then quadratic in u like the rest of its energy.
 // Gradient, with sigma_a = C0 : e_a and c_I = l_I^2 / 12:
 //   through F:           P^q_I = c_I sum_a G_a sigma_a      (added to P, same vectors g_IJ)
 //   through G_a = dF/dX_a: R_Ia = c_I F_I sigma_a,  f_I += V_I (R_I . Sum_I - sum_J R_J . T_IJ)
@@ -81,10 +83,17 @@ class TaylorQuadrature {
   Mat<D> stressAt(Index i, const Mat<D>& F, const SymMatrix& Gs) {
     if (weight_[i] == 0.0) return Mat<D>::Zero();  // R_i stays zero
     G_[i] = Gs;
-    const Gradients A = unpack(F.transpose() * Gs);  // F^T G_a
-    const Gradients G = unpack(Gs);
     Gradients sigma;
     Mat<D> Pq = Mat<D>::Zero();
+    if (smallStrain_[i]) {
+      const Gradients G = unpack(Gs);
+      for (int a = 0; a < D; ++a)
+        sigma[a] = weight_[i] * stressOf(i, G[a]);
+      R_[i] = symmetric(sigma);
+      return Pq;
+    }
+    const Gradients A = unpack(F.transpose() * Gs);  // F^T G_a
+    const Gradients G = unpack(Gs);
     for (int a = 0; a < D; ++a) {
       sigma[a] = weight_[i] * stressOf(i, A[a]);
       Pq.noalias() += G[a] * sigma[a];
@@ -109,14 +118,18 @@ class TaylorQuadrature {
       }
       const Gradients dG = secondGradients(i, v);
       const Gradients G = unpack(Gs[i]);
+      // small strain: F -> 1, dH -> 0, and no P^q
+      const bool small = smallStrain_[i];
+      const Mat<D> Fi = small ? Mat<D>::Identity() : F[i];
+      const Mat<D> dHi = small ? Mat<D>::Zero() : dH[i];
       Mat<D> dPq = Mat<D>::Zero();
       Gradients R;
       for (int a = 0; a < D; ++a) {
-        const Mat<D> sigma = weight_[i] * stressOf(i, F[i].transpose() * G[a]);
+        const Mat<D> sigma = weight_[i] * stressOf(i, Fi.transpose() * G[a]);
         const Mat<D> dsigma =
-            weight_[i] * stressOf(i, dH[i].transpose() * G[a] + F[i].transpose() * dG[a]);
-        dPq.noalias() += dG[a] * sigma + G[a] * dsigma;
-        R[a] = dH[i] * sigma + F[i] * dsigma;
+            weight_[i] * stressOf(i, dHi.transpose() * G[a] + Fi.transpose() * dG[a]);
+        if (!small) dPq.noalias() += dG[a] * sigma + G[a] * dsigma;
+        R[a] = dHi * sigma + Fi * dsigma;
       }
       R_[i] = symmetric(R);
       dstress[i] += dPq;
@@ -140,7 +153,7 @@ class TaylorQuadrature {
       double e = 0.0;
       const Gradients G = unpack(G_[i]);
       for (int a = 0; a < D; ++a) {
-        const Mat<D> ea = F[i].transpose() * G[a];
+        const Mat<D> ea = smallStrain_[i] ? G[a] : Mat<D>(F[i].transpose() * G[a]);
         e += (stressOf(i, ea).array() * (0.5 * (ea + ea.transpose())).array()).sum();
       }
       return 0.5 * volume_[i] * weight_[i] * e;  // V l^2 / 24 sum_a e_a : C0 : e_a
@@ -181,8 +194,9 @@ class TaylorQuadrature {
   const std::vector<double>& volume_;
   std::vector<Sym> S_, reverse_, sum_;  // S_IJ, T_IJ = (V_J / V_I) S_JI, sum_J S_IJ
   std::vector<double> weight_, lambda_, mu_;
-  std::vector<SymMatrix> G_;  // grad grad u, symmetric storage
-  std::vector<SymMatrix> R_;  // hyperstress, symmetric storage
+  std::vector<std::uint8_t> smallStrain_;  // linear-elastic material: e_a = sym(G_a)
+  std::vector<SymMatrix> G_;               // grad grad u, symmetric storage
+  std::vector<SymMatrix> R_;               // hyperstress, symmetric storage
   std::vector<Vec<D>> force_;
 };
 
