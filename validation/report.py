@@ -165,15 +165,18 @@ def mid_run(runs, key, dx, variant):
     return None
 
 
-DEFAULTS = {"kernel.support": 2.1, "kernel.correction": "quadratic", "hourglass.alpha": 10.0,
+DEFAULTS = {"kernel.support": 2.1, "kernel.correction": "quadratic",
+            "kernel.quadrature": "taylor", "hourglass.alpha": 10.0,
             "hourglass.form": "energy", "hourglass.gradient": "corrected",
             "clamp.method": "mirror", "time.cfl": 0.3, "static.tolerance": 1e-5}
 PARAM_NAME = {"kernel.support": "kernel.support (H/dx)", "kernel.correction": "kernel.correction",
+              "kernel.quadrature": "kernel.quadrature",
               "hourglass.alpha": "hourglass.alpha", "hourglass.form": "hourglass.form",
               "hourglass.gradient": "hourglass.gradient",
               "clamp.method": "clamp method (every [clamp.NAME])",
               "time.cfl": "time.cfl", "static.tolerance": "static.tolerance"}
-STUDIES = ["kernel.support", "kernel.correction", "hourglass.alpha", "hourglass.form",
+STUDIES = ["kernel.support", "kernel.correction", "kernel.quadrature", "hourglass.alpha",
+           "hourglass.form",
            "hourglass.gradient", "clamp.method", "time.cfl", "static.tolerance"]
 
 # Per problem: value columns of the ladder table: (header, function of a run -> text).
@@ -1928,6 +1931,7 @@ def make_plots(data, report_dir):
     # categorical studies: the change of the headline error from the default, in points
     ax = axes[3]
     cats = [("kernel.correction", "linear", "linear F\n(correction)"),
+            ("kernel.quadrature", "nodal", "nodal energy\nsum"),
             ("hourglass.form", "ganzenmueller", "Ganzenmueller\nform"),
             ("hourglass.gradient", "linear", "penalty on\nlinear F"),
             ("clamp.method", "fixed", "fixed ghost\nclamp")]

@@ -593,6 +593,7 @@ ALPHA = [0.1, 1.0, 30.0, 100.0]
 CFL = [0.4, 0.5, 0.6]
 TOL = [1e-4, 1e-6]
 LINEAR = ["linear"]
+NODAL = ["nodal"]  # kernel.quadrature: the one-point energy sum instead of the default taylor
 
 
 def hourglass_studies(clamped):
@@ -642,6 +643,7 @@ PROBLEMS = [
             extract_oscillating_plate, False, "period", "s", target=("period", 3.0),
             variants=[("Vf0.01", {}), ("Vf0.001", {"initial.mode.amplitude_over_c0": "0.001"})],
             sensitivity=dict({"kernel.support": SUPPORT, "kernel.correction": LINEAR,
+                              "kernel.quadrature": NODAL,
                               "time.cfl": CFL + [0.8]}, **hourglass_studies(False)),
             checked=["period"]),
     Problem("cantilever_static", "Cantilever under self-weight, static, 3D",
@@ -650,6 +652,7 @@ PROBLEMS = [
             target=("tip_vs_fem", 0.5), variants=[("", {})] + ALPHA_VARIANTS,
             variant_ladders={v: STATIC_ALPHA_LADDER for v, _ in ALPHA_VARIANTS},
             sensitivity=dict({"kernel.support": SUPPORT, "kernel.correction": LINEAR,
+                              "kernel.quadrature": NODAL,
                               "time.cfl": CFL, "static.tolerance": TOL},
                              **hourglass_studies(True)),
             checked=["tip_vs_fem", "tip", "tip_extrapolated"], clamps=["root"],
@@ -660,7 +663,8 @@ PROBLEMS = [
             extract_cantilever_dynamic, False, "first bending frequency", "Hz",
             variants=[("", {})] + ALPHA_VARIANTS,
             variant_ladders={v: DYNAMIC_ALPHA_LADDER for v, _ in ALPHA_VARIANTS},
-            sensitivity=dict({"kernel.correction": LINEAR, "time.cfl": CFL},
+            sensitivity=dict({"kernel.correction": LINEAR,
+                              "kernel.quadrature": NODAL, "time.cfl": CFL},
                              **hourglass_studies(True)),
             checked=["frequency", "mean_deflection", "time_average_deflection_vs_fem"],
             clamps=["root"]),
@@ -668,6 +672,7 @@ PROBLEMS = [
             [0.005, 0.0025, 0.00125], 0.005, 0.0025, extract_csm1, True,
             "tip displacement (point A)", "m", target=("displacement", 2.0),
             sensitivity=dict({"kernel.support": SUPPORT, "kernel.correction": LINEAR,
+                              "kernel.quadrature": NODAL,
                               "time.cfl": CFL, "static.tolerance": TOL},
                              **hourglass_studies(True)),
             checked=["displacement", "ux", "uy"], clamps=["root"],
@@ -676,6 +681,7 @@ PROBLEMS = [
             [0.005, 0.0025, 0.00125], 0.005, 0.0025, extract_csm3, False,
             "frequency", "Hz", target=("frequency", 2.0),
             sensitivity=dict({"kernel.support": [2.5, 3.0], "kernel.correction": LINEAR,
+                              "kernel.quadrature": NODAL,
                               "time.cfl": CFL}, **hourglass_studies(True)),
             checked=["frequency", "uy_mean", "uy_amp", "ux_mean", "ux_amp"], clamps=["root"]),
     Problem("clamped_plate", "Clamped square plate under pressure, static, 3D",
@@ -683,6 +689,7 @@ PROBLEMS = [
             0.0125, extract_clamped_plate, True, "centre deflection", "m",
             target=("w_vs_fem", 0.5),
             sensitivity=dict({"kernel.support": SUPPORT, "kernel.correction": LINEAR,
+                              "kernel.quadrature": NODAL,
                               "time.cfl": CFL, "static.tolerance": TOL},
                              **hourglass_studies(True)),
             checked=["w_vs_fem"], clamps=["left", "right", "front", "back"],
@@ -715,10 +722,12 @@ PROBLEMS = [
             newton_memory=NEWTON_MEMORY["plate_hole"], agree=["end_ux", "kt_top"]),
 ]
 BY_KEY = {p.key: p for p in PROBLEMS}
-DEFAULTS = {"kernel.support": 2.1, "kernel.correction": "quadratic", "hourglass.alpha": 10.0,
+DEFAULTS = {"kernel.support": 2.1, "kernel.correction": "quadratic",
+            "kernel.quadrature": "taylor", "hourglass.alpha": 10.0,
             "hourglass.form": "energy", "hourglass.gradient": "corrected",
             "clamp.method": "mirror", "time.cfl": 0.3, "static.tolerance": 1e-5}
-SHORT = {"kernel.support": "H", "kernel.correction": "", "hourglass.alpha": "alpha",
+SHORT = {"kernel.support": "H", "kernel.correction": "", "kernel.quadrature": "",
+         "hourglass.alpha": "alpha",
          "hourglass.form": "hg", "hourglass.gradient": "hggrad", "clamp.method": "clamp",
          "time.cfl": "cfl", "static.tolerance": "tol"}
 

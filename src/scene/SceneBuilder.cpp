@@ -239,9 +239,10 @@ class Builder {
         parseGradientCorrection(k.word("correction", "quadratic", {"linear", "quadratic"}));
     setup_.scene.supportRadius = ratio * setup_.dx;
     // nodal = the one-point sum_I V_I psi(F_I); taylor adds its second-order term
-    // (TaylorQuadrature.hpp; it needs the quadratic fit).
+    // (TaylorQuadrature.hpp), the default where it can run: it needs the quadratic fit.
     const bool quadratic = setup_.scene.gradientCorrection == GradientCorrection::Quadratic;
-    setup_.scene.quadrature = parseQuadrature(k.word("quadrature", "nodal", {"nodal", "taylor"}));
+    setup_.scene.quadrature = parseQuadrature(
+        k.word("quadrature", quadratic ? "taylor" : "nodal", {"nodal", "taylor"}));
     if (setup_.scene.quadrature == Quadrature::Taylor && !quadratic)
       throw k.error("quadrature",
                     "taylor needs correction = quadratic (its second derivatives come from the "
