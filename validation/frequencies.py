@@ -318,7 +318,7 @@ def build_report(results, beam, fem_refs, fem_recs):
     L.append("Written by `/usr/bin/python3 validation/frequencies.py` (runs in "
              "validation/runs/frequencies/, each on one thread: `OMP_NUM_THREADS=1`). "
              "tlsph at the defaults of the scenes (quadratic correction, energy-form hourglass "
-             "penalty alpha = 10, mirrored clamp), modes about the reference state "
+             "penalty alpha = 10, mirrored clamp, Taylor quadrature), modes about the reference state "
              "(docs/modes.md); the scenes' material linearises there to linear elasticity "
              "with E = 1e7 Pa, nu = 0.3, rho = 1000 kg/m^3. Modes are named from their shapes "
              "(validation/fem.py `classify_beam_mode`, `classify_plate_mode`: the same "
