@@ -156,34 +156,9 @@ ReferenceConfiguration<D> buildReferenceConfiguration(
   return ref;
 }
 
-template <int D>
-std::vector<Vec<D>> reverseVectors(const NeighbourList& nb, const std::vector<Vec<D>>& g,
-                                   const std::vector<double>& volume) {
-  // (J, I) is found by binary search in J's sorted list.
-  std::vector<Vec<D>> t(nb.pairCount());
-  const Index n = nb.particleCount();
-  bool symmetric = true;
-#pragma omp parallel for reduction(&& : symmetric) schedule(static)
-  for (Index i = 0; i < n; ++i)
-    for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
-      const Index j = nb.neighbour[k];
-      const auto first = nb.neighbour.begin() + nb.offset[j];
-      const auto last = nb.neighbour.begin() + nb.offset[j + 1];
-      const auto at = std::lower_bound(first, last, i);
-      if (at == last || *at != i) {
-        symmetric = false;
-        continue;
-      }
-      t[k] = (volume[j] / volume[i]) * g[at - nb.neighbour.begin()];
-    }
-  if (!symmetric) throw SetupError("internal: neighbour lists are not symmetric");
-  return t;
+void throwAsymmetricNeighbourLists() {
+  throw SetupError("internal: neighbour lists are not symmetric");
 }
-
-template std::vector<Vec<2>> reverseVectors<2>(const NeighbourList&, const std::vector<Vec<2>>&,
-                                               const std::vector<double>&);
-template std::vector<Vec<3>> reverseVectors<3>(const NeighbourList&, const std::vector<Vec<3>>&,
-                                               const std::vector<double>&);
 
 template ReferenceConfiguration<2> buildReferenceConfiguration<2>(const std::vector<Vec<2>>&,
                                                                   const std::vector<double>&,

@@ -2,6 +2,7 @@
 // neighbour lists, per-pair kernel data and the inverse correction tensors L_I^{-1}.
 #pragma once
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -11,6 +12,8 @@
 #include "tlsph/Types.hpp"
 
 namespace tlsph {
+
+[[noreturn]] void throwAsymmetricNeighbourLists();
 
 // How the gradient of a particle field is corrected (DESIGN.md section 2, and README):
 //   Linear: (6.69), gradW times L_I^{-1}; exact for linear fields.
@@ -73,11 +76,37 @@ struct ReferenceConfiguration {
   Index particleCount() const { return neighbours.particleCount(); }
 };
 
-// t_IJ = (V_J / V_I) g_JI for every pair (I, J) of the (symmetric, sorted) full lists: the
-// reverse pair's vector, so a force -dE/du_I is gathered from I's own list.
+// t_IJ = (V_J / V_I) a_JI for every pair (I, J) of the (symmetric, sorted) full lists: the
+// reverse pair's value, so a force -dE/du_I is gathered from I's own list. (J, I) is found by
+// binary search in J's sorted list. Throws SetupError if a list is not symmetric.
+template <class Value>
+std::vector<Value> reversePairValues(const NeighbourList& nb, const std::vector<Value>& a,
+                                     const std::vector<double>& volume) {
+  std::vector<Value> t(nb.pairCount());
+  const Index n = nb.particleCount();
+  bool symmetric = true;
+#pragma omp parallel for reduction(&& : symmetric) schedule(static)
+  for (Index i = 0; i < n; ++i)
+    for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
+      const Index j = nb.neighbour[k];
+      const auto first = nb.neighbour.begin() + nb.offset[j];
+      const auto last = nb.neighbour.begin() + nb.offset[j + 1];
+      const auto at = std::lower_bound(first, last, i);
+      if (at == last || *at != i) {
+        symmetric = false;
+        continue;
+      }
+      t[k] = (volume[j] / volume[i]) * a[at - nb.neighbour.begin()];
+    }
+  if (!symmetric) throwAsymmetricNeighbourLists();
+  return t;
+}
+
 template <int D>
 std::vector<Vec<D>> reverseVectors(const NeighbourList& nb, const std::vector<Vec<D>>& g,
-                                   const std::vector<double>& volume);
+                                   const std::vector<double>& volume) {
+  return reversePairValues(nb, g, volume);
+}
 
 // Smallest accepted reciprocal condition number of L_I (sigma_min / sigma_max).
 inline constexpr double kDefaultMinCorrectionCondition = 1e-6;

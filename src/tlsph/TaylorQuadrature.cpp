@@ -67,16 +67,7 @@ TaylorQuadrature<D>::TaylorQuadrature(const ReferenceConfiguration<D>& ref,
     }
   }
   // T_IJ = (V_J / V_I) S_JI
-  reverse_.assign(nb.pairCount(), Sym::Zero());
-  for (Index i = 0; i < n; ++i)
-    for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
-      const Index j = nb.neighbour[k];
-      const auto first = nb.neighbour.begin() + nb.offset[j];
-      const auto last = nb.neighbour.begin() + nb.offset[j + 1];
-      const auto at = std::lower_bound(first, last, i);
-      if (at != last && *at == i)
-        reverse_[k] = (volume[j] / volume[i]) * S_[at - nb.neighbour.begin()];
-    }
+  reverse_ = reversePairValues(nb, S_, volume);
   G_.assign(n, SymMatrix::Zero());
   R_.assign(n, SymMatrix::Zero());
   force_.assign(n, Vec<D>::Zero());
