@@ -183,6 +183,15 @@ TEST_F(CheckpointRestart, NewtonStatic3DNonlinearContinuesBitForBit) {
                  randomStep(1, 2));
 }
 
+TEST_F(CheckpointRestart, NewtonMultigridContinuesBitForBit) {
+  // The multigrid's coarse level and smoother are rebuilt from the load time, displacements,
+  // F and second gradients saved at its last renewal; the restart runs on another thread count.
+  restartMatches(scene("validation/scenes/cantilever_large.ini") +
+                     " --scene.dx=0.025 --static.solver=newton --static.load_steps=4"
+                     " --static.preconditioner=multigrid",
+                 randomStep(1, 2), 2);
+}
+
 // SIGTERM at a random moment once the run has begun (its first series written): exit 143 with a
 // checkpoint; restarting from it ('latest') ends exactly where the uninterrupted run ends.
 TEST_F(CheckpointRestart, TerminatedRunRestartsFromItsCheckpoint) {

@@ -95,6 +95,7 @@ Scene<D> heldBlock(const Case& c, bool ghosts, std::mt19937& rng) {
 template <int D>
 struct Matrices {
   Eigen::MatrixXd applied, differenced, assembled;
+  std::vector<Mat<D>> diagonal;  // TangentStiffness::diagonalBlocks()
 };
 
 template <int D>
@@ -122,6 +123,7 @@ Matrices<D> matricesOf(Scene<D>& scene, std::mt19937& rng) {
   }
   const Eigen::SparseMatrix<double> full = K.assemble().template selfadjointView<Eigen::Lower>();
   m.assembled = Eigen::MatrixXd(full);
+  m.diagonal = K.diagonalBlocks();
   // -df/du_k by central differences of the net force on the unknowns
   m.differenced = differencedStiffness(solver, p.displacement, dofs.freeParticles(), 1e-6 * kDx);
   return m;
@@ -139,6 +141,12 @@ void expectTangent(const Case& c, bool ghosts, std::uint32_t seed) {
   // Central differences of a smooth force: truncation ~h^2, round-off ~eps |f| / h.
   EXPECT_LT((m.applied - m.differenced).cwiseAbs().maxCoeff(), 1e-5 * scale);
   EXPECT_LT((m.applied - m.applied.transpose()).cwiseAbs().maxCoeff(), 1e-10 * scale);
+  // The diagonal blocks without the assembly are the assembled matrix's.
+  ASSERT_EQ(static_cast<Index>(m.diagonal.size()) * D, m.assembled.rows());
+  for (std::size_t q = 0; q < m.diagonal.size(); ++q)
+    EXPECT_LT(
+        (m.diagonal[q] - m.assembled.template block<D, D>(D * q, D * q)).cwiseAbs().maxCoeff(),
+        1e-12 * scale);
   if (c.alpha == 0.0) {
     EXPECT_LT((m.assembled - m.applied).cwiseAbs().maxCoeff(), 1e-10 * scale);
   } else {

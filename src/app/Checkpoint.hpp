@@ -129,6 +129,10 @@ void writeCheckpoint(const std::filesystem::path& file, const Checkpoint<D>& c) 
     w.putVector("newton.seconds",
                 std::vector<double>{st.assemblySeconds, st.factorisationSeconds, st.solveSeconds});
     w.putVector("newton.factor_deformation", n.factorDeformation);
+    w.put("newton.levels", static_cast<std::int32_t>(st.levels));
+    w.put("newton.factor_time", n.factorTime);
+    w.putVector("newton.factor_displacement", n.factorDisplacement);
+    w.putVector("newton.factor_second_gradients", n.factorSecondGradients);
   }
 
   const OutputProgress& o = c.output;
@@ -212,6 +216,14 @@ Checkpoint<D> readCheckpoint(const CheckpointReader& r) {
     st.factorisationSeconds = seconds[1];
     st.solveSeconds = seconds[2];
     n.factorDeformation = r.getVector<Mat<D>>("newton.factor_deformation");
+    // The multigrid preconditioner's state (absent from checkpoints of earlier versions).
+    if (r.has("newton.factor_time")) {
+      st.levels = r.get<std::int32_t>("newton.levels");
+      n.factorTime = r.get<double>("newton.factor_time");
+      n.factorDisplacement = r.getVector<Vec<D>>("newton.factor_displacement");
+      n.factorSecondGradients =
+          r.getVector<typename TaylorQuadrature<D>::SymMatrix>("newton.factor_second_gradients");
+    }
     c.newton = std::move(n);
   }
   OutputProgress& o = c.output;

@@ -147,7 +147,7 @@ void writeRunRecord(const std::filesystem::path& file, const SceneSetup<D>& setu
     o << "{\"load_steps\": " << n.loadSteps << ", \"iterations\": " << n.iterations
       << ", \"krylov_iterations\": " << n.krylovIterations
       << ", \"factorisations\": " << n.factorisations << ", \"matrix_nonzeros\": " << n.nonZeros
-      << ", \"factor_nonzeros\": " << n.factorNonZeros
+      << ", \"factor_nonzeros\": " << n.factorNonZeros << ", \"levels\": " << n.levels
       << ", \"assembly_seconds\": " << jsonNumber(n.assemblySeconds)
       << ", \"factorisation_seconds\": " << jsonNumber(n.factorisationSeconds)
       << ", \"solve_seconds\": " << jsonNumber(n.solveSeconds)

@@ -309,7 +309,7 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
 
   if (run.newtonStatic()) {
     // Load steps to equilibrium: one series row and one frame per converged step.
-    NewtonSolver<D> newton(setup.scene, solver, run.newton);
+    NewtonSolver<D> newton(setup.scene, solver, run.newton, setup.coarsen, setup.solver);
     if (resume) {
       if (!resume->newton)
         throw CheckpointError("the checkpoint holds no Newton state (written by a damped run)");

@@ -129,7 +129,13 @@ void printSetup(const SceneSetup<D>& setup, const Solver<D>& solver) {
     const double end = solver.rampEnd();
     std::cout << "static       Newton-Raphson, " << setup.run.newton.loadSteps
               << " load step(s) to the end of the ramps (t = " << end
-              << " s), stop when residual < " << setup.run.tolerance << "\n";
+              << " s), stop when residual < " << setup.run.tolerance << "; preconditioner "
+              << newtonPreconditionerName(setup.run.newton.preconditioner);
+    if (setup.run.newton.preconditioner == NewtonPreconditioner::Auto)
+      std::cout << " (multigrid from " << NewtonSolver<D>::kAutoMultigridUnknowns
+                << " unknowns unless a Poisson ratio >= " << NewtonSolver<D>::kAutoPoissonLimit
+                << ", else cholesky)";
+    std::cout << "\n";
   }
   const double steps = setup.run.endTime / solver.timeStep();
   std::cout << "time         dt = " << solver.timeStep() << " s (CFL " << setup.solver.cfl
@@ -289,11 +295,17 @@ int runOrCheck(const Config& config, bool run, bool progress, const std::string&
     std::cout << "\nNewton       " << n.loadSteps << " load steps, " << n.iterations
               << " iterations";
     if (n.krylovIterations > 0) std::cout << ", " << n.krylovIterations << " CG iterations";
-    std::cout << ", " << n.factorisations << " factorisations (" << n.linearSolver << ", "
-              << n.nonZeros << " stored entries); wall " << s.wallSeconds << " s: assembly "
-              << n.assemblySeconds << ", factorisation " << n.factorisationSeconds << ", solves "
-              << n.solveSeconds << " (" << threads << (threads == 1 ? " thread" : " threads")
-              << ")\n";
+    if (n.levels > 1)
+      std::cout << ", " << n.factorisations << " preconditioner set-ups (" << n.linearSolver
+                << "; coarsest matrix " << n.nonZeros << " stored entries, factor "
+                << n.factorNonZeros << "); wall " << s.wallSeconds << " s: set-up "
+                << n.factorisationSeconds;
+    else
+      std::cout << ", " << n.factorisations << " factorisations (" << n.linearSolver << ", "
+                << n.nonZeros << " stored entries); wall " << s.wallSeconds << " s: assembly "
+                << n.assemblySeconds << ", factorisation " << n.factorisationSeconds;
+    std::cout << ", solves " << n.solveSeconds << " (" << threads
+              << (threads == 1 ? " thread" : " threads") << ")\n";
   } else {
     std::cout << "\nsteps " << s.steps << ", simulated " << s.time << " s, wall " << s.wallSeconds
               << " s (" << double(setup.scene.particles.size()) * s.steps / s.wallSeconds

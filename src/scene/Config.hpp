@@ -45,6 +45,13 @@ class Config {
   std::vector<std::string> keys(const std::string& section) const;
   // Every entry as ("section.key", value), sorted; does not mark anything used.
   std::vector<std::pair<std::string, std::string>> settings() const;
+  // A copy with one key set (as a command-line override would), e.g. a coarser scene.dx.
+  Config with(const std::string& dottedKey, const std::string& value,
+              const std::string& origin) const {
+    Config c = *this;
+    c.set(dottedKey, value, origin);
+    return c;
+  }
 
  private:
   void addSection(const std::string& section, const std::string& where);

@@ -3,10 +3,13 @@
 #include <array>
 #include <cmath>
 #include <filesystem>
+#include <iomanip>
 #include <map>
+#include <memory>
 #include <numbers>
 #include <random>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 
 #include "geometry/LatticeFill.hpp"
@@ -241,8 +244,8 @@ class Builder {
     // nodal = the one-point sum_I V_I psi(F_I); taylor adds its second-order term
     // (TaylorQuadrature.hpp), the default where it can run: it needs the quadratic fit.
     const bool quadratic = setup_.scene.gradientCorrection == GradientCorrection::Quadratic;
-    setup_.scene.quadrature = parseQuadrature(
-        k.word("quadrature", quadratic ? "taylor" : "nodal", {"nodal", "taylor"}));
+    setup_.scene.quadrature =
+        parseQuadrature(k.word("quadrature", quadratic ? "taylor" : "nodal", {"nodal", "taylor"}));
     if (setup_.scene.quadrature == Quadrature::Taylor && !quadratic)
       throw k.error("quadrature",
                     "taylor needs correction = quadratic (its second derivatives come from the "
@@ -786,6 +789,11 @@ class Builder {
       throw s.error("max_iterations",
                     "must be between 1 and 100000, got " + config_.get("static", "max_iterations"));
     n.maxIterations = static_cast<int>(iterations);
+    const std::string preconditioner =
+        s.word("preconditioner", "auto", {"auto", "cholesky", "multigrid"});
+    n.preconditioner = preconditioner == "cholesky"    ? NewtonPreconditioner::Cholesky
+                       : preconditioner == "multigrid" ? NewtonPreconditioner::Multigrid
+                                                       : NewtonPreconditioner::Auto;
     s.finish();
     SectionReader t(config_, "time");
     setup_.solver.cfl = t.positive("cfl", kDefaultCfl);
@@ -954,7 +962,19 @@ int sceneDimension(const Config& config) {
 
 template <int D>
 SceneSetup<D> buildScene(const Config& config) {
-  return Builder<D>(config).build();
+  SceneSetup<D> setup = Builder<D>(config).build();
+  const double dx = setup.dx;
+  setup.coarsen = [config, dx](int factor) -> std::unique_ptr<Scene<D>> {
+    std::ostringstream spacing;
+    spacing << std::setprecision(17) << factor * dx;
+    try {
+      Config coarse = config.with("scene.dx", spacing.str(), "multigrid coarsening");
+      return std::make_unique<Scene<D>>(Builder<D>(coarse).build().scene);
+    } catch (const std::exception&) {
+      return nullptr;  // too coarse for this geometry: no such level
+    }
+  };
+  return setup;
 }
 
 template SceneSetup<2> buildScene<2>(const Config&);

@@ -69,6 +69,8 @@ struct SceneSetup {
   std::string name;
   std::string sourceFile;
   double dx = 0.0;
+  // The scene rebuilt at `factor` times dx (the Newton solver's multigrid levels).
+  SceneCoarsening<D> coarsen;
   Scene<D> scene;
   SolverSettings solver;
   RunSettings run;

@@ -1,22 +1,78 @@
 // NewtonSolver (see the header), compiled once for 2D and 3D.
 #include "tlsph/NewtonSolver.hpp"
 
+#include <algorithm>
+
 #include "tlsph/ConjugateGradients.hpp"
 
 namespace tlsph {
 
 template <int D>
-NewtonSolver<D>::NewtonSolver(Scene<D>& scene, Solver<D>& solver, const NewtonSettings& settings)
+NewtonSolver<D>::NewtonSolver(Scene<D>& scene, Solver<D>& solver, const NewtonSettings& settings,
+                              const SceneCoarsening<D>& coarsen,
+                              const SolverSettings& solverSettings)
     : scene_(scene),
       solver_(solver),
       settings_(settings),
       dofs_(scene.particles, scene.mirrorGhosts),
       tangent_(solver.reference(), scene.materials, scene.particles.material,
                scene.particles.volume, scene.hourglass(), dofs_, scene.quadrature) {
-  statistics_.linearSolver = SparseCholesky::name();
-  if (!tangent_.assemblyExact())
-    statistics_.linearSolver = "conjugate gradients preconditioned by " + statistics_.linearSolver;
   if (settings.loadSteps < 1) throw SetupError("[static] load_steps must be at least 1");
+  const Index unknowns = D * dofs_.size();
+  const bool explicitly = settings.preconditioner == NewtonPreconditioner::Multigrid;
+  // Block-Jacobi smoothing cannot reach the volumetric modes of a nearly incompressible body
+  // (Cook's membrane at nu = 0.4999: the conjugate gradients stall), a direct factor can.
+  double poisson = 0.0;
+  for (const Material& m : scene.materials) {
+    const auto c = elasticConstants(m);
+    poisson = std::max(poisson, c.lambda / (2.0 * (c.lambda + c.mu)));
+  }
+  const bool wanted =
+      explicitly || (settings.preconditioner == NewtonPreconditioner::Auto &&
+                     unknowns >= kAutoMultigridUnknowns && poisson < kAutoPoissonLimit && coarsen);
+  if (wanted) {
+    if (!coarsen)
+      throw SetupError("[static] preconditioner = multigrid needs the scene rebuilt coarser");
+    // Levels at 2, 4, ... times the spacing while they still shrink, down to a cheap factor.
+    std::vector<std::unique_ptr<Scene<D>>> coarse;
+    Index last = unknowns;
+    for (int factor = 2; (coarse.empty() || last > kCoarsestUnknowns) && factor <= 64;
+         factor *= 2) {
+      std::unique_ptr<Scene<D>> s = coarsen(factor);
+      if (!s) break;
+      Index free = 0;
+      for (Motion m : s->particles.motion)
+        free += m == Motion::Free;
+      if (free == 0 || 2 * D * free > last) break;  // no coarser (points from a file, say)
+      last = D * free;
+      coarse.push_back(std::move(s));
+    }
+    if (coarse.empty()) {
+      if (explicitly)
+        throw SetupError(
+            "[static] preconditioner = multigrid: the scene cannot be rebuilt at twice its "
+            "particle spacing with fewer unknowns (use preconditioner = cholesky)");
+    } else {
+      multigrid_ = std::make_unique<MultigridPreconditioner<D>>(scene, dofs_, tangent_,
+                                                                std::move(coarse), solverSettings);
+      statistics_.levels = multigrid_->levelCount();
+    }
+  }
+  statistics_.linearSolver = multigrid_ ? multigrid_->description() : SparseCholesky::name();
+  if (multigrid_ || !tangent_.assemblyExact())
+    statistics_.linearSolver = "conjugate gradients preconditioned by " + statistics_.linearSolver;
+}
+
+template <int D>
+NewtonSolver<D>::~NewtonSolver() = default;
+
+template <int D>
+void NewtonSolver<D>::useCholesky(const std::string& why) {
+  multigrid_.reset();
+  factorised_ = false;
+  statistics_.levels = 1;
+  statistics_.linearSolver = "conjugate gradients preconditioned by " + SparseCholesky::name() +
+                             " (multigrid given up: " + why + ")";
 }
 
 template <int D>
@@ -46,7 +102,8 @@ void NewtonSolver<D>::run(const std::function<bool()>& onStep) {
       msg << "Newton solver: no equilibrium at load time t = " << target << " s";
       if (end > 0.0) msg << " (" << 100.0 * target / end << " % of the load)";
       msg << ": " << why << ". The output holds the last converged state (t = " << done_
-          << " s). Try more load steps ([static] load_steps), or solver = damped.";
+          << " s). Try more load steps ([static] load_steps)"
+          << (multigrid_ ? ", [static] preconditioner = cholesky" : "") << ", or solver = damped.";
       throw NewtonFailure(msg.str());
     }
     increment_ *= 0.5;
@@ -64,7 +121,14 @@ NewtonState<D> NewtonSolver<D>::state() const {
   s.lastKrylov = lastKrylov_;
   s.lastStep = lastStep_;
   s.statistics = statistics_;
-  if (factorised_) s.factorDeformation = factorDeformation_;
+  if (factorised_) {
+    s.factorDeformation = factorDeformation_;
+    if (multigrid_) {
+      s.factorTime = factorTime_;
+      s.factorDisplacement = factorDisplacement_;
+      s.factorSecondGradients = factorSecondGradients_;
+    }
+  }
   return s;
 }
 
@@ -77,13 +141,24 @@ void NewtonSolver<D>::resume(const NewtonState<D>& s) {
   lastKrylov_ = s.lastKrylov;
   lastStep_ = s.lastStep;
   factorised_ = false;
+  // The interrupted run had given up its multigrid: so does this one.
+  if (multigrid_ && s.statistics.levels == 1) useCholesky("as before the restart");
   if (s.factorised) {
     // The same matrix as before the stop: the tangent at the saved F, factorised again.
     if (s.factorDeformation.size() != scene_.particles.displacement.size())
       throw SetupError("the saved Newton state does not fit the scene (particle count)");
     tangent_.update(s.factorDeformation);
     std::string why;
-    if (!factorise(why)) throw NewtonFailure("Newton solver: on restart, " + why);
+    if (multigrid_) {
+      tangent_.updateQuadrature(s.factorSecondGradients, s.factorDeformation);
+      if (s.factorDisplacement.size() != scene_.particles.displacement.size() ||
+          !updateMultigrid(s.factorTime, s.factorDisplacement, s.factorDeformation,
+                           s.factorSecondGradients, why))
+        throw NewtonFailure("Newton solver: on restart, the multigrid preconditioner: " +
+                            (why.empty() ? std::string("the saved state does not fit") : why));
+    } else if (!factorise(why)) {
+      throw NewtonFailure("Newton solver: on restart, " + why);
+    }
     factorDeformation_ = s.factorDeformation;
   }
   const std::string linearSolver = statistics_.linearSolver;
@@ -118,7 +193,31 @@ void NewtonSolver<D>::move(const Eigen::VectorXd& du, double s) {
 }
 
 template <int D>
+bool NewtonSolver<D>::updateMultigrid(double t, const std::vector<Vec<D>>& u,
+                                      const std::vector<Mat<D>>& F,
+                                      const std::vector<typename TaylorQuadrature<D>::SymMatrix>& G,
+                                      std::string& why) {
+  const auto t0 = Clock::now();
+  factorised_ = multigrid_->update(t, u, why);
+  statistics_.factorisationSeconds += seconds(t0);
+  statistics_.nonZeros = multigrid_->coarsestNonZeros();
+  statistics_.factorNonZeros = multigrid_->coarsestFactorNonZeros();
+  ++statistics_.factorisations;
+  factorDeformation_ = F;
+  factorTime_ = t;
+  factorDisplacement_ = u;
+  factorSecondGradients_ = G;
+  return factorised_;
+}
+
+template <int D>
 bool NewtonSolver<D>::factorise(std::string& why) {
+  if (multigrid_) {
+    const TaylorQuadrature<D>* q = solver_.forces().quadrature();
+    return updateMultigrid(
+        loadTime_, scene_.particles.displacement, solver_.forces().deformationGradient(),
+        q ? q->secondGradients() : std::vector<typename TaylorQuadrature<D>::SymMatrix>{}, why);
+  }
   auto t0 = Clock::now();
   const auto& K = tangent_.assemble();
   statistics_.nonZeros = K.nonZeros();
@@ -145,11 +244,10 @@ bool NewtonSolver<D>::solveLinear(const Eigen::VectorXd& r, Eigen::VectorXd& du,
   const double forceScale = ratio > 0.0 ? r.norm() / ratio : r.norm();
   const double target =
       std::max(settings_.linearTolerance * r.norm(), 0.1 * settings_.tolerance * forceScale);
-  du = factor_.solve(r);
+  du = precondition(r);
   const ConjugateGradientResult cg = conjugateGradients(
       [&](const Eigen::VectorXd& v, Eigen::VectorXd& Kv) { tangent_.apply(v, Kv); },
-      [&](const Eigen::VectorXd& v) { return factor_.solve(v); }, r, du, target, kMaxKrylov,
-      kStall);
+      [&](const Eigen::VectorXd& v) { return precondition(v); }, r, du, target, kMaxKrylov, kStall);
   const int iterations = cg.iterations;
   statistics_.krylovIterations += iterations;
   statistics_.solveSeconds += seconds(t0);
@@ -177,6 +275,7 @@ bool NewtonSolver<D>::solveLinear(const Eigen::VectorXd& r, Eigen::VectorXd& du,
 template <int D>
 bool NewtonSolver<D>::solveAt(double t, std::string& why) {
   solver_.beginStaticStep(t);
+  loadTime_ = t;
   Eigen::VectorXd r, du, rTrial;
   for (int it = 0; it < settings_.maxIterations; ++it) {
     const double ratio = solver_.residualRatio();
@@ -196,7 +295,11 @@ bool NewtonSolver<D>::solveAt(double t, std::string& why) {
     if (!factorised_ || lastKrylov_ > kRefactorAfter)
       if (!factorise(why)) return false;
     if (!solveLinear(r, du, why)) {
-      // A stale preconditioner may be the reason: once more with a fresh one.
+      // A stale preconditioner may be the reason: once more with a fresh one; a multigrid the
+      // solver chose itself gives way to the direct factor.
+      if (multigrid_ && settings_.preconditioner == NewtonPreconditioner::Auto)
+        useCholesky("the multigrid conjugate gradients stalled at load time t = " +
+                    std::to_string(t) + " s");
       if (!factorise(why) || !solveLinear(r, du, why)) return false;
     }
     ++statistics_.iterations;

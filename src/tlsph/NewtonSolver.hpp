@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -19,13 +20,26 @@
 
 #include "tlsph/DofMap.hpp"
 #include "tlsph/Errors.hpp"
+#include "tlsph/MultigridPreconditioner.hpp"
 #include "tlsph/Solver.hpp"
 #include "tlsph/SparseCholesky.hpp"
 #include "tlsph/TangentStiffness.hpp"
 
 namespace tlsph {
 
+// What preconditions the conjugate gradients: the sparse Cholesky factor of the assembled
+// tangent, a multigrid V-cycle over the scene rebuilt at coarser spacings, or (auto) the
+// multigrid from kAutoMultigridUnknowns scalar unknowns on when the scene can be coarsened and
+// is not nearly incompressible (falling back to the factor if its iteration stalls).
+enum class NewtonPreconditioner { Auto, Cholesky, Multigrid };
+inline const char* newtonPreconditionerName(NewtonPreconditioner p) {
+  return p == NewtonPreconditioner::Cholesky    ? "cholesky"
+         : p == NewtonPreconditioner::Multigrid ? "multigrid"
+                                                : "auto";
+}
+
 struct NewtonSettings {
+  NewtonPreconditioner preconditioner = NewtonPreconditioner::Auto;
   int loadSteps = 1;                    // equal steps up to the end of the longest ramp
   double tolerance = 1e-5;              // out-of-balance force ratio (Solver::residualRatio)
   double displacementTolerance = 1e-8;  // |du| / |u| of the last Newton correction
@@ -33,6 +47,11 @@ struct NewtonSettings {
   int maxCuts = 6;                      // halvings of a load step before the solve gives up
   double linearTolerance = 1e-6;        // relative residual of the inner conjugate gradients
 };
+
+// The same scene at `factor` times the particle spacing (2, 4, ...), for the multigrid levels;
+// null when it cannot be built that coarse.
+template <int D>
+using SceneCoarsening = std::function<std::unique_ptr<Scene<D>>(int factor)>;
 
 // What a Newton solve did, for the run record.
 struct NewtonStatistics {
@@ -42,6 +61,7 @@ struct NewtonStatistics {
   int factorisations = 0;
   long nonZeros = 0;        // stored entries of the assembled matrix (lower triangle)
   long factorNonZeros = 0;  // stored entries of its Cholesky factor
+  int levels = 1;           // multigrid levels (1: the Cholesky factor of the whole matrix)
   double assemblySeconds = 0.0, factorisationSeconds = 0.0, solveSeconds = 0.0;
   std::string linearSolver;
 };
@@ -60,6 +80,11 @@ struct NewtonState {
   double lastStep = 0.0;
   NewtonStatistics statistics;
   std::vector<Mat<D>> factorDeformation;  // F at the last factorisation
+  // Multigrid: the load time, every particle's u and the Taylor second gradients at the last
+  // preconditioner update (the coarse levels and the smoother are rebuilt from them).
+  double factorTime = 0.0;
+  std::vector<Vec<D>> factorDisplacement;
+  std::vector<typename TaylorQuadrature<D>::SymMatrix> factorSecondGradients;
 };
 
 // A Newton solve that could not reach equilibrium; the message says at which load and why.
@@ -70,7 +95,11 @@ class NewtonFailure : public std::runtime_error {
 template <int D>
 class NewtonSolver {
  public:
-  NewtonSolver(Scene<D>& scene, Solver<D>& solver, const NewtonSettings& settings);
+  // `coarsen` builds the multigrid levels (preconditioner multigrid or auto); without it the
+  // Cholesky factor is used.
+  NewtonSolver(Scene<D>& scene, Solver<D>& solver, const NewtonSettings& settings,
+               const SceneCoarsening<D>& coarsen = {}, const SolverSettings& solverSettings = {});
+  ~NewtonSolver();
 
   const NewtonStatistics& statistics() const { return statistics_; }
   const DofMap<D>& dofs() const { return dofs_; }
@@ -97,6 +126,15 @@ class NewtonSolver {
   double displacementNorm() const;
   void move(const Eigen::VectorXd& du, double s);
   bool factorise(std::string& why);
+  // Drops the multigrid for the Cholesky factor (auto mode, after a stall), saying why.
+  void useCholesky(const std::string& why);
+  // Multigrid: the preconditioner at load time t, displacements u (F, second gradients G).
+  bool updateMultigrid(double t, const std::vector<Vec<D>>& u, const std::vector<Mat<D>>& F,
+                       const std::vector<typename TaylorQuadrature<D>::SymMatrix>& G,
+                       std::string& why);
+  Eigen::VectorXd precondition(const Eigen::VectorXd& r) {
+    return multigrid_ ? multigrid_->apply(r) : factor_.solve(r);
+  }
   // Preconditioned conjugate gradients on the exact K; false on negative curvature.
   bool solveLinear(const Eigen::VectorXd& r, Eigen::VectorXd& du, std::string& why);
   bool solveAt(double t, std::string& why);
@@ -107,10 +145,20 @@ class NewtonSolver {
   DofMap<D> dofs_;
   TangentStiffness<D> tangent_;
   SparseCholesky factor_;
+  std::unique_ptr<MultigridPreconditioner<D>> multigrid_;  // instead of factor_ when set
   // Conjugate-gradient iterations: the most per solve, and how many make the preconditioner stale.
   static constexpr int kMaxKrylov = 500;
   static constexpr int kRefactorAfter = 25;
   static constexpr int kStall = 20;  // iterations over which the residual must halve
+ public:
+  // auto: the Cholesky factor below this many scalar unknowns, or for a material with a Poisson
+  // ratio from kAutoPoissonLimit on (measured crossovers, docs/static.md)
+  static constexpr Index kAutoMultigridUnknowns = 15000;
+  static constexpr double kAutoPoissonLimit = 0.45;
+  // Coarsen until a level has at most this many scalar unknowns (its factor is then cheap).
+  static constexpr Index kCoarsestUnknowns = 30000;
+
+ private:
   bool factorised_ = false;
   double lastStep_ = 0.0;
   int lastKrylov_ = 0;
@@ -120,6 +168,9 @@ class NewtonSolver {
   int cuts_ = 0;
   bool started_ = false, resumed_ = false;
   std::vector<Mat<D>> factorDeformation_;
+  double factorTime_ = 0.0, loadTime_ = 0.0;
+  std::vector<Vec<D>> factorDisplacement_;
+  std::vector<typename TaylorQuadrature<D>::SymMatrix> factorSecondGradients_;
 };
 
 extern template class NewtonSolver<2>;

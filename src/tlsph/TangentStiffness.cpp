@@ -154,6 +154,67 @@ const typename TangentStiffness<D>::SparseMatrix& TangentStiffness<D>::assemble(
 }
 
 template <int D>
+std::vector<Mat<D>> TangentStiffness<D>::diagonalBlocks() const {
+  const auto& nb = ref_.neighbours;
+  const Index nd = dofs_.size();
+  std::vector<Mat<D>> diagonal(nd, Mat<D>::Zero());
+  // Each particle's stencil spans the unknowns of I and its neighbours: [lo, hi].
+  std::vector<Index> lo(n_, nd), hi(n_, -1);
+#pragma omp parallel for schedule(static)
+  for (Index i = 0; i < n_; ++i) {
+    auto widen = [&](Index particle) {
+      auto [t, end] = dofs_.terms(particle);
+      for (; t != end; ++t) {
+        lo[i] = std::min(lo[i], t->dof);
+        hi[i] = std::max(hi[i], t->dof);
+      }
+    };
+    widen(i);
+    for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k)
+      widen(nb.neighbour[k]);
+  }
+  // As in assemble(): each thread owns a range of unknowns and takes the particles in order.
+#pragma omp parallel
+  {
+    int thread = 0, threads = 1;
+#ifdef _OPENMP
+    thread = omp_get_thread_num();
+    threads = omp_get_num_threads();
+#endif
+    const Index first = nd * thread / threads, last = nd * (thread + 1) / threads;
+    Stencil s;
+    for (Index i = 0; i < n_; ++i) {
+      if (hi[i] < first || lo[i] >= last) continue;
+      reducedStencil(i, s);
+      const Index m = static_cast<Index>(s.dof.size());
+      for (Index p = s.position(first); p < m && s.dof[p] < last; ++p) {
+        Mat<D> block = Mat<D>::Zero();
+        if (hasEnergy_[i]) {
+          const Kronecker AB = modulus_[i] * kroneckerIdentity(s.b[p]);
+          for (int j = 0; j < D; ++j)
+            block.noalias() += s.b[p][j] * AB.template middleRows<D>(D * j);
+          block *= volume_[i];
+        }
+        if (penalty_) {
+          // 1/2 V_I sum_J k_IJ C(p, J)^2, C as in assemble()
+          double sum = 0.0;
+          for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
+            double c = s.self[p] - s.bh[p].dot(ref_.separation[k]);
+            auto [t, end] = dofs_.terms(nb.neighbour[k]);
+            for (; t != end; ++t)
+              if (t->dof == s.dof[p]) c -= t->weight;
+            sum += c_[k] * c * c;
+          }
+          block.diagonal().array() += 0.5 * volume_[i] * sum;
+        }
+        diagonal[s.dof[p]] += block;
+      }
+    }
+  }
+  return diagonal;
+}
+
+template <int D>
 void TangentStiffness<D>::reducedStencil(Index i, Stencil& s) const {
   const auto& nb = ref_.neighbours;
   s.clear();

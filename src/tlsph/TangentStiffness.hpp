@@ -110,6 +110,13 @@ class TangentStiffness {
     quadratureF_ = F;
     quadratureG_ = q->secondGradients();
   }
+  // The same from saved second gradients (a restart).
+  void updateQuadrature(const std::vector<typename TaylorQuadrature<D>::SymMatrix>& G,
+                        const std::vector<Mat<D>>& F) {
+    if (!quadrature_ || G.empty()) return;
+    quadratureF_ = F;
+    quadratureG_ = G;
+  }
 
   // Kv = K v, exactly (v and Kv: D values per unknown, stacked).
   // Which part of K a product takes: all of it, the strain energy's, or the penalty's.
@@ -119,6 +126,10 @@ class TangentStiffness {
   // The sparse matrix described at the top, lower triangle only (use selfadjointView<Lower>).
   // The pattern is built on the first call.
   const SparseMatrix& assemble();
+  // The diagonal blocks of assemble()'s matrix, one D x D block per unknown, without building
+  // the matrix (the block-Jacobi part of the multigrid smoother). Reproducible bit for bit on
+  // any thread count.
+  std::vector<Mat<D>> diagonalBlocks() const;
   // Adds d (one value per unknown) to the diagonal of the last assembled matrix, e.g. -sigma
   // times the masses for the shifted matrix K - sigma M of a modal analysis.
   void addToDiagonal(const Eigen::VectorXd& d);
