@@ -2,6 +2,7 @@
 #include "tlsph/MlsInterpolation.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 
 #include "tlsph/NeighbourList.hpp"
 
@@ -11,47 +12,45 @@ template <int D>
 InterpolationMatrix mlsInterpolation(const std::vector<Vec<D>>& targets,
                                      const std::vector<Vec<D>>& sources, const Kernel<D>& kernel,
                                      const PeriodicBox<D>& box) {
-  // One neighbour search over both sets: the pairs (target, source) are what is needed.
-  std::vector<Vec<D>> all(targets);
-  all.insert(all.end(), sources.begin(), sources.end());
-  const NeighbourList nb = buildNeighbourList<D>(all, kernel.supportRadius(), box);
+  const NeighbourList nb = buildNeighbourList<D>(targets, sources, kernel.supportRadius(), box);
   const Index nt = static_cast<Index>(targets.size());
   const double H = kernel.supportRadius();
   using Basis = Eigen::Matrix<double, D + 1, 1>;
   using Moment = Eigen::Matrix<double, D + 1, D + 1>;
-  std::vector<Eigen::Triplet<double, Index>> entries;
-  std::vector<std::pair<Index, double>> weights;
+  // The weights take the search's pattern (rows sorted by source): a row-major matrix.
+  std::vector<double> value(nb.pairCount(), 0.0);
+#pragma omp parallel for schedule(dynamic, 256)
   for (Index t = 0; t < nt; ++t) {
-    weights.clear();
-    Moment M = Moment::Zero();
-    double total = 0.0;
     auto basis = [&](Index c) {
       Basis q;
       q[0] = 1.0;
       q.template tail<D>() = box.separation(sources[c], targets[t]) / H;
       return q;
     };
+    Moment M = Moment::Zero();
+    double total = 0.0;
     for (Index k = nb.offset[t]; k < nb.offset[t + 1]; ++k) {
-      const Index c = nb.neighbour[k] - nt;
-      if (c < 0) continue;
+      const Index c = nb.neighbour[k];
       const double w = kernel.value(box.separation(sources[c], targets[t]).norm());
-      if (w <= 0.0) continue;
-      weights.emplace_back(c, w);
+      value[k] = w;
       M.noalias() += w * basis(c) * basis(c).transpose();
       total += w;
     }
-    if (weights.empty()) continue;
+    if (!(total > 0.0)) continue;
     const Eigen::SelfAdjointEigenSolver<Moment> eigen(M);
     const bool linear = eigen.eigenvalues().minCoeff() > 1e-8 * eigen.eigenvalues().maxCoeff();
     Basis row = Basis::Zero();  // e_0^T M^{-1}
     if (linear)
       row = eigen.eigenvectors() * (eigen.eigenvalues().cwiseInverse().asDiagonal() *
                                     eigen.eigenvectors().row(0).transpose());
-    for (const auto& [c, w] : weights)
-      entries.emplace_back(t, c, linear ? w * row.dot(basis(c)) : w / total);
+    for (Index k = nb.offset[t]; k < nb.offset[t + 1]; ++k)
+      value[k] = linear ? value[k] * row.dot(basis(nb.neighbour[k])) : value[k] / total;
   }
   InterpolationMatrix W(nt, static_cast<Index>(sources.size()));
-  W.setFromTriplets(entries.begin(), entries.end());
+  W.resizeNonZeros(nb.pairCount());
+  std::copy(nb.offset.begin(), nb.offset.end(), W.outerIndexPtr());
+  std::copy(nb.neighbour.begin(), nb.neighbour.end(), W.innerIndexPtr());
+  std::copy(value.begin(), value.end(), W.valuePtr());
   return W;
 }
 

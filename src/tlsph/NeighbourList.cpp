@@ -39,15 +39,16 @@ struct CellGrid {
   }
 };
 
-}  // namespace
-
+// For each query point, the points within supportRadius (sorted); `self`: the queries are the
+// points, and a point is not its own neighbour.
 template <int D>
-NeighbourList buildNeighbourList(const std::vector<Vec<D>>& X, double supportRadius,
-                                 const PeriodicBox<D>& box) {
+NeighbourList search(const std::vector<Vec<D>>& Q, const std::vector<Vec<D>>& X,
+                     double supportRadius, const PeriodicBox<D>& box, bool self) {
   const Index n = static_cast<Index>(X.size());
+  const Index nq = static_cast<Index>(Q.size());
   NeighbourList list;
-  list.offset.assign(n + 1, 0);
-  if (n == 0) return list;
+  list.offset.assign(nq + 1, 0);
+  if (n == 0 || nq == 0) return list;
 
   Vec<D> lo = X[0], hi = X[0];
   for (const auto& x : X) {
@@ -95,16 +96,19 @@ NeighbourList buildNeighbourList(const std::vector<Vec<D>>& X, double supportRad
   }
 
   const double r2max = supportRadius * supportRadius;
-  std::vector<std::vector<Index>> found(n);
+  std::vector<std::vector<Index>> found(nq);
 #pragma omp parallel for schedule(dynamic, 256)
-  for (Index i = 0; i < n; ++i) {
+  for (Index i = 0; i < nq; ++i) {
+    std::array<Index, D> own;
+    for (int a = 0; a < D; ++a)
+      own[a] = self ? coordOfParticle[i][a] : grid.coordinate(Q[i], a);
     // Distinct neighbouring cell coordinates per axis (fewer than 3 cells: no repeats).
     std::array<std::array<Index, 3>, D> axisCells{};
     std::array<int, D> axisCount{};
     for (int a = 0; a < D; ++a) {
       int k = 0;
       for (int o = -1; o <= 1; ++o) {
-        Index c = coordOfParticle[i][a] + o;
+        Index c = own[a] + o;
         if (grid.periodic[a]) {
           c = (c % grid.cells[a] + grid.cells[a]) % grid.cells[a];
         } else if (c < 0 || c >= grid.cells[a]) {
@@ -126,8 +130,8 @@ NeighbourList buildNeighbourList(const std::vector<Vec<D>>& X, double supportRad
       const Index cell = grid.linear(c);
       for (Index k = cellStart[cell]; k < cellStart[cell + 1]; ++k) {
         const Index j = cellParticles[k];
-        if (j == i) continue;
-        if (box.separation(X[i], X[j]).squaredNorm() < r2max) out.push_back(j);
+        if (self && j == i) continue;
+        if (box.separation(Q[i], X[j]).squaredNorm() < r2max) out.push_back(j);
       }
       int a = 0;
       while (a < D && ++it[a] == axisCount[a])
@@ -137,17 +141,36 @@ NeighbourList buildNeighbourList(const std::vector<Vec<D>>& X, double supportRad
     std::sort(out.begin(), out.end());
   }
 
-  for (Index i = 0; i < n; ++i)
+  for (Index i = 0; i < nq; ++i)
     list.offset[i + 1] = list.offset[i] + static_cast<Index>(found[i].size());
-  list.neighbour.resize(list.offset[n]);
-  for (Index i = 0; i < n; ++i)
+  list.neighbour.resize(list.offset[nq]);
+  for (Index i = 0; i < nq; ++i)
     std::copy(found[i].begin(), found[i].end(), list.neighbour.begin() + list.offset[i]);
   return list;
+}
+
+}  // namespace
+
+template <int D>
+NeighbourList buildNeighbourList(const std::vector<Vec<D>>& X, double supportRadius,
+                                 const PeriodicBox<D>& box) {
+  return search<D>(X, X, supportRadius, box, true);
+}
+
+template <int D>
+NeighbourList buildNeighbourList(const std::vector<Vec<D>>& queries,
+                                 const std::vector<Vec<D>>& points, double supportRadius,
+                                 const PeriodicBox<D>& box) {
+  return search<D>(queries, points, supportRadius, box, false);
 }
 
 template NeighbourList buildNeighbourList<2>(const std::vector<Vec<2>>&, double,
                                              const PeriodicBox<2>&);
 template NeighbourList buildNeighbourList<3>(const std::vector<Vec<3>>&, double,
                                              const PeriodicBox<3>&);
+template NeighbourList buildNeighbourList<2>(const std::vector<Vec<2>>&, const std::vector<Vec<2>>&,
+                                             double, const PeriodicBox<2>&);
+template NeighbourList buildNeighbourList<3>(const std::vector<Vec<3>>&, const std::vector<Vec<3>>&,
+                                             double, const PeriodicBox<3>&);
 
 }  // namespace tlsph

@@ -25,4 +25,11 @@ template <int D>
 NeighbourList buildNeighbourList(const std::vector<Vec<D>>& X, double supportRadius,
                                  const PeriodicBox<D>& box = {});
 
+// For each query point, the points within supportRadius (two different sets; list I holds
+// indices into `points`). Same periodic rules.
+template <int D>
+NeighbourList buildNeighbourList(const std::vector<Vec<D>>& queries,
+                                 const std::vector<Vec<D>>& points, double supportRadius,
+                                 const PeriodicBox<D>& box = {});
+
 }  // namespace tlsph
