@@ -132,8 +132,8 @@ void printSetup(const SceneSetup<D>& setup, const Solver<D>& solver) {
               << " s), stop when residual < " << setup.run.tolerance << "; preconditioner "
               << newtonPreconditionerName(setup.run.newton.preconditioner);
     if (setup.run.newton.preconditioner == NewtonPreconditioner::Auto)
-      std::cout << " (multigrid from " << NewtonSolver<D>::kAutoMultigridUnknowns
-                << " unknowns unless a Poisson ratio >= " << NewtonSolver<D>::kAutoPoissonLimit
+      std::cout << " (multigrid from " << setup.run.newton.autoMultigridUnknowns
+                << " unknowns unless a Poisson ratio >= " << setup.run.newton.autoPoissonLimit
                 << ", else cholesky)";
     std::cout << "\n";
   }

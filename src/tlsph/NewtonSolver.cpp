@@ -27,9 +27,9 @@ NewtonSolver<D>::NewtonSolver(Scene<D>& scene, Solver<D>& solver, const NewtonSe
     const auto c = elasticConstants(m);
     poisson = std::max(poisson, c.lambda / (2.0 * (c.lambda + c.mu)));
   }
-  const bool wanted =
-      explicitly || (settings.preconditioner == NewtonPreconditioner::Auto &&
-                     unknowns >= kAutoMultigridUnknowns && poisson < kAutoPoissonLimit && coarsen);
+  const bool wanted = explicitly || (settings.preconditioner == NewtonPreconditioner::Auto &&
+                                     unknowns >= settings.autoMultigridUnknowns &&
+                                     poisson < settings.autoPoissonLimit && coarsen);
   if (wanted) {
     if (!coarsen)
       throw SetupError("[static] preconditioner = multigrid needs the scene rebuilt coarser");

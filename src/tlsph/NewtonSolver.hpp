@@ -29,7 +29,7 @@ namespace tlsph {
 
 // What preconditions the conjugate gradients: the sparse Cholesky factor of the assembled
 // tangent, a multigrid V-cycle over the scene rebuilt at coarser spacings, or (auto) the
-// multigrid from kAutoMultigridUnknowns scalar unknowns on when the scene can be coarsened and
+// multigrid from autoMultigridUnknowns scalar unknowns on when the scene can be coarsened and
 // is not nearly incompressible (falling back to the factor if its iteration stalls).
 enum class NewtonPreconditioner { Auto, Cholesky, Multigrid };
 inline const char* newtonPreconditionerName(NewtonPreconditioner p) {
@@ -40,6 +40,10 @@ inline const char* newtonPreconditionerName(NewtonPreconditioner p) {
 
 struct NewtonSettings {
   NewtonPreconditioner preconditioner = NewtonPreconditioner::Auto;
+  // auto: the Cholesky factor below this many scalar unknowns, or for a material with a Poisson
+  // ratio from autoPoissonLimit on (measured crossovers, docs/static.md)
+  long autoMultigridUnknowns = 15000;
+  double autoPoissonLimit = 0.45;
   int loadSteps = 1;                    // equal steps up to the end of the longest ramp
   double tolerance = 1e-5;              // out-of-balance force ratio (Solver::residualRatio)
   double displacementTolerance = 1e-8;  // |du| / |u| of the last Newton correction
@@ -150,15 +154,8 @@ class NewtonSolver {
   static constexpr int kMaxKrylov = 500;
   static constexpr int kRefactorAfter = 25;
   static constexpr int kStall = 20;  // iterations over which the residual must halve
- public:
-  // auto: the Cholesky factor below this many scalar unknowns, or for a material with a Poisson
-  // ratio from kAutoPoissonLimit on (measured crossovers, docs/static.md)
-  static constexpr Index kAutoMultigridUnknowns = 15000;
-  static constexpr double kAutoPoissonLimit = 0.45;
   // Coarsen until a level has at most this many scalar unknowns (its factor is then cheap).
   static constexpr Index kCoarsestUnknowns = 30000;
-
- private:
   bool factorised_ = false;
   double lastStep_ = 0.0;
   int lastKrylov_ = 0;
