@@ -829,9 +829,10 @@ def solver_table(key, p, runs, variant):
     L = ["**Damped dynamics against Newton%s** (the primary run uses the scene's solver, "
          "%s; its twin is the same run with `--static.solver=%s`; error = the Newton run's "
          "(the damped one's agrees, last column); wall time as the program measures it; "
-         "memory = peak resident set; K = the assembled stiffness' stored entries (lower "
-         "triangle), factor = the entries of the Cholesky factor (of K, or of the coarsest "
-         "multigrid level); last column: the largest relative difference of %s "
+         "memory = peak resident set; K and factor = the stored entries (lower triangle) of "
+         "the matrix CHOLMOD factorises and of its factor: the assembled stiffness with the "
+         "Cholesky preconditioner, the coarsest level with the multigrid; last column: the "
+         "largest relative difference of %s "
          "between the two, which must be below %g x the static tolerance)" % (
              (", " + variant_label(p, variant)) if len(p["variants"]) > 1 else "",
              prim, twin,
@@ -915,12 +916,14 @@ def solvers_section(P, runs, meta):
         L.append("")
     # the memory
     L.append("**What Newton costs in memory** (default variant of each problem; K entries = "
-             "the stored lower triangle of the assembled stiffness, one entry per coupled pair "
-             "of unknowns: the neighbours of neighbours; factor = the supernodal Cholesky "
-             "factor's entries (of K with the Cholesky preconditioner, of the coarsest level "
-             "with the multigrid), 8 bytes each; the peak resident memory of the Newton run "
-             "holds K, the preconditioner (the factor, or the coarse levels and the MLS "
-             "transfers) and the solver's vectors)")
+             "the stored lower triangle of the matrix CHOLMOD factorises, one entry per coupled "
+             "pair of unknowns (the neighbours of neighbours), and factor = its supernodal "
+             "Cholesky factor's entries, 8 bytes each: with the Cholesky preconditioner the "
+             "assembled K itself, with the multigrid its coarsest level (the run's "
+             "summary.json reports that level's), so K per particle is given for the "
+             "Cholesky runs only; the peak resident memory of the Newton run holds K, the "
+             "preconditioner (the factor, or the coarse levels and the MLS transfers) and the "
+             "solver's vectors)")
     L.append("")
     rows, fits, ratios = [], [], []
     for key, p in static:
@@ -939,9 +942,10 @@ def solvers_section(P, runs, meta):
             nz, fz = st.get("matrix_nonzeros"), st.get("factor_nonzeros")
             ratio = (n["peak_rss_mb"] / d["peak_rss_mb"]
                      if n.get("peak_rss_mb") and d.get("peak_rss_mb") else None)
+            chol = preconditioner_text(n) == "Cholesky"
             rows.append([short_title(key, p), d["per_thickness"], particles(d),
                          preconditioner_text(n), g(nz, 3),
-                         f3(nz / float(d["particles"]), 0) if nz and d.get("particles")
+                         f3(nz / float(d["particles"]), 0) if chol and nz and d.get("particles")
                          else "-", g(fz, 3), mem(n.get("peak_rss_mb")),
                          mem(d.get("peak_rss_mb")), x_text(ratio) if ratio else "-"])
             if ratio and npart > 20000:

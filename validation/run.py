@@ -618,12 +618,15 @@ STATIC_ALPHA_LADDER = [0.025, 0.0125, 0.01, 0.1 / 12]  # 16 through cut (budget)
 # auto` Newton stores the assembled stiffness K and either the CHOLMOD factor (below 15,000
 # scalar unknowns, or Poisson's ratio >= 0.45: Cook's nearly incompressible membrane) or the
 # multigrid hierarchy (K's Galerkin coarse levels and the MLS transfers), whose size grows about
-# as the particle count: about 3 times the damped run's memory. Each static problem has a
-# model of the peak resident memory, GB(n) = GB_ref (n / n_ref)^exponent (n = particles per
+# as the particle count N (measured: Newton's peak memory ~ N^0.97-1.17 over the 3D ladders,
+# 2.1-2.7 times the damped run's above 20,000 particles). Each static problem has a model of
+# the peak resident memory, GB(n) = GB_ref (n / n_ref)^exponent (n = particles per
 # thickness), anchored at the finest Newton run of the problem measured by the runner (wait4
-# ru_maxrss, 2 threads on the 2-core machine, commit 27c1e8e, 2026-11-30; the exponent between
-# the two finest 3D runs, at least 2.5 in 3D; 2.5 in 2D, where the Cholesky factor grows about
-# as N log N). The runner predicts each Newton run's memory from the finest Newton run of the
+# ru_maxrss; 2 threads on the 2-core machine, binary of commit 27c1e8e, 2026-11-29; the full
+# validation of the solver reversal). Exponent in 3D: the one between the two finest runs of
+# the problem (3.0-3.4: N grows as n^3 and slightly faster); in 2D 2.5, a bound (the finest
+# runs grow as n^1.5-1.7; the Cholesky factor as N log N). The runner predicts each Newton
+# run's memory from the finest Newton run of the
 # same problem it has measured so far (else from this anchor), with the larger of the model's
 # exponent and the one observed between the two finest measured runs when both exceed
 # MEMORY_FLOOR_GB (below that the program's fixed size and the switch between the Cholesky
@@ -632,14 +635,15 @@ STATIC_ALPHA_LADDER = [0.025, 0.0125, 0.01, 0.1 / 12]  # 16 through cut (budget)
 NEWTON_BUDGET_GB = 10.0
 MEMORY_LIMIT_GB = 10.5  # any run (damped or Newton) above this resident size is stopped
 MEMORY_FLOOR_GB = 0.5
-NEWTON_MEMORY = {
-    "cantilever_static": (16, 1.0, 3.0),  # PRELIMINARY
-    "cantilever_large": (10, 0.3, 3.0),
-    "clamped_plate": (16, 8.0, 2.54),  # 1.38, 8.0 GB at 8, 16 through (docs/static.md)
-    "csm1": (16, 0.063, 2.5),  # Cholesky at every size (at most 9,056 unknowns)
+NEWTON_MEMORY = {  # measured peak resident memory of the Newton runs (multigrid from 15,000
+    # unknowns), GB: 0.045, 0.11, 0.24, 0.35, 0.91 at 4, 8, 10, 12, 16 through
+    "cantilever_static": (16, 0.91, 3.3),
+    "cantilever_large": (10, 0.24, 3.4),  # 0.045, 0.11, 0.24 at 4, 8, 10
+    "clamped_plate": (16, 7.6, 3.0),  # 0.15, 0.50, 1.28, 1.87, 7.6 at 4, 6, 8, 10, 16
+    "csm1": (16, 0.062, 2.5),  # Cholesky at every size (at most 9,056 unknowns)
     "cook_membrane": (32, 0.13, 2.5),  # Cholesky at every size (at most 12,020 unknowns)
     "cook_membrane_incompressible": (32, 0.12, 2.5),  # Cholesky (nu = 0.4999)
-    "plate_hole": (32, 0.6, 2.5),
+    "plate_hole": (32, 0.65, 2.5),  # 0.10, 0.20, 0.65 at 8, 16, 32 (Cholesky at 8)
 }
 # A twin agrees with its primary when every checked value differs by less than
 # NEWTON_AGREEMENT times the static tolerance (relative): both stop at an out-of-balance ratio
