@@ -1143,6 +1143,8 @@ def execute(problem, run, build_dir, runs_dir, R, git, reuse, timeout,
                            peak_rss_mb=old.get("peak_rss_mb"))
                 if old.get("stderr"):
                     rec["stderr"] = old["stderr"]
+                if old.get("adopted_from"):  # a run renamed to the id it now has
+                    rec["adopted_from"] = old["adopted_from"]
                 reused = True
         except (OSError, ValueError):
             pass
