@@ -505,6 +505,23 @@ def readme(data, plots, plot_note):
         "; %d of them reused from an earlier invocation of the same ladder (`--reuse`: same "
         "command, run after the scene file last changed; their wall times are those measured "
         "then)" % reused if reused else ""))
+    adopted = [r for r in runs if r.get("adopted_from")]
+    if adopted:
+        renamed = sum(1 for r in adopted if r["adopted_from"].get("id") != r["id"])
+        L.append("| adopted runs | %d of the reused runs were adopted from an earlier "
+                 "invocation after a change of layout (%d of them renamed, e.g. `%s` was "
+                 "`%s`): each record's `adopted_from` has the command it was made with, "
+                 "checked at the adoption to equal the new one but for the checkout path%s |" % (
+                     len(adopted), renamed,
+                     next((r["id"] for r in adopted if r["adopted_from"].get("id") != r["id"]),
+                          adopted[0]["id"]),
+                     next((r["adopted_from"]["id"] for r in adopted
+                           if r["adopted_from"].get("id") != r["id"]),
+                          adopted[0]["adopted_from"].get("id")),
+                     ", the run directory and, for the static problems, the "
+                     "`--static.solver=damped` now given explicitly (the scenes' solver was "
+                     "damped then; their summary.json says static_solver = damped; "
+                     "validation/report_notes.md)" if renamed else ""))
     L.append("| wall time | %.0f s for all runs (%.1f min), of which the ladders %.0f s "
              "(the static ladders' twins %.0f s of them) and the sensitivity studies "
              "%.0f s |" % (
