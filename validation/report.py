@@ -110,17 +110,25 @@ def richardson(hs, qs):
 
 
 def is_newton(r):
-    """A static ladder run's Newton twin (`--static.solver=newton`, run.py)."""
+    """A static run made with the Newton solver (a primary or a twin)."""
     return r.get("solver") == "newton"
 
 
-def ladder(runs, key, variant=None, solver="damped"):
-    """Ladder runs of a problem, coarse to fine; variant None = all variants. solver "damped"
-    (the default: every table but the solver comparison) or "newton" (the twins, skipped ones
-    included)."""
+def is_twin(r):
+    """A static ladder run's twin: the same run with the other solver (run.py; records before
+    the solver reversal had no `twin` field and their twins were the Newton runs)."""
+    if "twin" in r:
+        return bool(r["twin"])
+    return is_newton(r)
+
+
+def ladder(runs, key, variant=None, solver=None):
+    """Ladder runs of a problem, coarse to fine; variant None = all variants. solver None: the
+    primary runs (the scene's solver: every table but the solver comparison); "damped" or
+    "newton": the runs with that solver, primaries or twins (skipped ones included)."""
     out = [r for r in runs if r["problem"] == key and r["kind"] == "ladder" and
            (variant is None or r["variant"] == variant) and
-           is_newton(r) == (solver == "newton")]
+           (not is_twin(r) if solver is None else r.get("solver") == solver)]
     return sorted(out, key=lambda r: -r["dx"])
 
 
@@ -157,10 +165,12 @@ def sensitivity(runs, key, param, p=None):
     return sorted(out, key=lambda r: r["value"])
 
 
-def mid_run(runs, key, dx, variant):
+def mid_run(runs, key, dx, variant, study=False):
+    """The ladder run of a variant at dx: the primary, or (study) the one with the sensitivity
+    studies' solver (damped: the static problems' studies keep it), their baseline."""
     for r in runs:
         if (r["problem"] == key and r["kind"] == "ladder" and abs(r["dx"] - dx) < 1e-12 and
-                r["variant"] == variant and not is_newton(r)):
+                r["variant"] == variant and (not is_newton(r) if study else not is_twin(r))):
             return r
     return None
 
@@ -395,12 +405,16 @@ def with_static_comparison(runs):
     in %, where that static run exists."""
     out = [dict(r) for r in runs]
     static = [r for r in out if r["problem"] == "cantilever_static" and r.get("qoi") and
-              not is_newton(r)]
+              not is_twin(r)]
+
+    def settings(r):
+        return {k: v for k, v in r["overrides"].items() if k != "static.solver"}
+
     for r in out:
         if r["problem"] != "cantilever_dynamic" or val(r, "mean_deflection") is None:
             continue
         for s in static:
-            if abs(s["dx"] - r["dx"]) < 1e-12 and s["overrides"] == r["overrides"]:
+            if abs(s["dx"] - r["dx"]) < 1e-12 and settings(s) == settings(r):
                 w = val(s, "tip")
                 if w:
                     r["_vs_static"] = 100.0 * (val(r, "mean_deflection") - w) / w
@@ -419,16 +433,23 @@ def extra_error(r, name):
     return None if e is None else e
 
 
-def newton_cell(runs, r):
-    """The summary's Newton column: the twin's wall time at the finest resolution."""
-    n = newton_twin(runs, r)
-    if n is None:
+def twin_cell(runs, r):
+    """The summary's last column: at the finest resolution of a static problem, the solver of
+    the primary run and the twin's wall time (the other solver), with Newton's speed-up."""
+    if not r.get("solver"):
         return "-"
-    if n.get("outcome") == "skipped":
-        return "not run (memory: %.0f GB predicted)" % (n.get("predicted_memory_gb") or 0)
-    if not converged(n):
-        return n.get("outcome") or str(n.get("rc"))
-    return "%.1f (%s)" % (n["wall_seconds"], x_text(speedup(r, n)))
+    other = "damped" if r["solver"] == "newton" else "newton"
+    t = counterpart(runs, r, other)
+    if t is None:
+        return "%s; no %s twin" % (r["solver"], other)
+    if t.get("outcome") == "skipped":
+        return "%s; %s not run (memory: %.0f GB predicted)" % (
+            r["solver"], other, t.get("predicted_memory_gb") or 0)
+    if not converged(t):
+        return "%s; %s %s" % (r["solver"], other, t.get("outcome") or str(t.get("rc")))
+    d, n = (r, t) if r["solver"] == "damped" else (t, r)
+    return "%s; %s %.1f (Newton %s)" % (r["solver"], other, t["wall_seconds"],
+                                       x_text(speedup(d, n)))
 
 
 def readme(data, plots, plot_note):
@@ -479,18 +500,35 @@ def readme(data, plots, plot_note):
     reused = sum(1 for r in runs if r.get("reused"))
     skipped = sum(1 for r in runs if r.get("outcome") == "skipped")
     L.append("| runs | %d%s, started %s%s |" % (
-        len(runs) - skipped, " (and %d Newton twins skipped for their predicted memory, not "
+        len(runs) - skipped, " (and %d Newton runs skipped for their predicted memory, not "
         "run)" % skipped if skipped else "", meta.get("started", "?"),
         "; %d of them reused from an earlier invocation of the same ladder (`--reuse`: same "
         "command, run after the scene file last changed; their wall times are those measured "
         "then)" % reused if reused else ""))
+    adopted = [r for r in runs if r.get("adopted_from")]
+    if adopted:
+        renamed = sum(1 for r in adopted if r["adopted_from"].get("id") != r["id"])
+        L.append("| adopted runs | %d of the reused runs were adopted from an earlier "
+                 "invocation after a change of layout (%d of them renamed, e.g. `%s` was "
+                 "`%s`): each record's `adopted_from` has the command it was made with, "
+                 "checked at the adoption to equal the new one but for the checkout path%s |" % (
+                     len(adopted), renamed,
+                     next((r["id"] for r in adopted if r["adopted_from"].get("id") != r["id"]),
+                          adopted[0]["id"]),
+                     next((r["adopted_from"]["id"] for r in adopted
+                           if r["adopted_from"].get("id") != r["id"]),
+                          adopted[0]["adopted_from"].get("id")),
+                     ", the run directory and, for the static problems, the "
+                     "`--static.solver=damped` now given explicitly (the scenes' solver was "
+                     "damped then; their summary.json says static_solver = damped; "
+                     "validation/report_notes.md)" if renamed else ""))
     L.append("| wall time | %.0f s for all runs (%.1f min), of which the ladders %.0f s "
-             "(the static ladders' Newton twins %.0f s of them) and the sensitivity studies "
+             "(the static ladders' twins %.0f s of them) and the sensitivity studies "
              "%.0f s |" % (
                  total_wall, total_wall / 60.0,
                  sum(r.get("wall_runner") or 0 for r in runs if r["kind"] == "ladder"),
                  sum(r.get("wall_runner") or 0 for r in runs if r["kind"] == "ladder" and
-                     is_newton(r)),
+                     is_twin(r)),
                  sum(r.get("wall_runner") or 0 for r in runs if r["kind"] == "sensitivity")))
     L.append("| command | `%s%s` |" % (
         "OMP_WAIT_POLICY=%s " % meta["omp_wait_policy"] if meta.get("omp_wait_policy") else "",
@@ -557,10 +595,10 @@ def readme(data, plots, plot_note):
                      err(fin, q.get("primary", "")) if q else outcome(fin),
                      extra or "-",
                      "%s %%" % tgt[1] if tgt else "-", met, o,
-                     "%.0f" % (fin.get("wall_seconds") or 0), newton_cell(runs, fin)])
+                     "%.1f" % (fin.get("wall_seconds") or 0), twin_cell(runs, fin)])
     L += table(["problem", "quantity (error)", "finest: per thickness / dx", "error %",
                 "other errors at the finest, %", "target", "met", "order (last pair)",
-                "wall s", "Newton wall s (static)"], rows)
+                "wall s", "static: solver; twin's wall s"], rows)
     L.append("")
     L.append("Details, what limits each target, and the sensitivity studies follow. "
              "Order = observed order of the error against the reference between the two finest "
@@ -599,7 +637,10 @@ def readme(data, plots, plot_note):
              "defaults (support 2.1 dx, quadratic correction, hourglass alpha 10 in the energy "
              "form on the corrected F, mirrored clamps, CFL 0.3, static tolerance 1e-5 in the "
              "validation scenes); the default row is the ladder run, and the cantilevers' "
-             "alpha 1 and 30 rows are their ladder variants. `clamp method = fixed` sets "
+             "alpha 1 and 30 rows are their ladder variants. The static problems' studies "
+             "use the damped solver (`--static.solver=damped`: the CFL study is about the "
+             "damped dynamics), so their default row is the ladder's damped run (the twin "
+             "where the scene's solver is Newton). `clamp method = fixed` sets "
              "`method = fixed` on every `[clamp.NAME]` of the scene. Exit status 4 "
              "(`unstable`) is a result: the guard's message is quoted under the table. `hg "
              "min` is the smallest value of the `hourglass` column of energies.csv: the "
@@ -627,27 +668,50 @@ def readme(data, plots, plot_note):
 
 
 # --------------------------------------------------------------------------------------------
-# Static problems: the damped dynamics against Newton (run.py's Newton twins)
+# Static problems: the damped dynamics against Newton (a primary run and its twin, run.py)
 
 TIE = 1.1  # a speed-up within 10 % either way: a tie on the shared machine
 
 
-def newton_twin(runs, r):
-    """The Newton twin of a damped ladder run (same problem, variant and dx), or None."""
+def counterpart(runs, r, solver):
+    """The ladder run with the same problem, variant and dx as r made with `solver` (r itself
+    if it is), or None."""
+    if r.get("solver") == solver:
+        return r
     for x in runs:
-        if (is_newton(x) and x["kind"] == "ladder" and x["problem"] == r["problem"] and
-                x["variant"] == r["variant"] and abs(x["dx"] - r["dx"]) < 1e-12):
+        if (x.get("solver") == solver and x["kind"] == "ladder" and
+                x["problem"] == r["problem"] and x["variant"] == r["variant"] and
+                abs(x["dx"] - r["dx"]) < 1e-12):
             return x
     return None
 
 
+def newton_twin(runs, r):
+    """The Newton run beside a damped ladder run (its primary or its twin), or None."""
+    return counterpart(runs, r, "newton")
+
+
 def solver_pairs(runs, key, variant):
-    """[(damped run, its Newton twin or None)] of a ladder, coarse to fine."""
-    return [(r, newton_twin(runs, r)) for r in ladder(runs, key, variant)]
+    """[(damped run, Newton run or None)] of a ladder, coarse to fine (the primaries' sizes;
+    a size without a damped run is left out)."""
+    out = []
+    for r in ladder(runs, key, variant):
+        d = counterpart(runs, r, "damped")
+        if d is not None:
+            out.append((d, counterpart(runs, r, "newton")))
+    return out
 
 
 def has_twins(runs, key):
-    return any(is_newton(r) and r["problem"] == key for r in runs)
+    return any(is_twin(r) and r["problem"] == key for r in runs)
+
+
+def primary_solver_of(runs, key):
+    """The solver of a static problem's primary runs (the scene's), or None."""
+    for r in runs:
+        if r["problem"] == key and r["kind"] == "ladder" and not is_twin(r):
+            return r.get("solver")
+    return None
 
 
 def converged(r):
@@ -682,8 +746,24 @@ def newton_stats(n):
         ", %d load steps" % st["load_steps"] if (st.get("load_steps") or 1) > 1 else "")
 
 
-def agreement_text(n):
-    a = (n or {}).get("agreement") or {}
+def preconditioner_text(n):
+    """The Newton run's preconditioner: the multigrid (levels) or the Cholesky factor."""
+    st = (n or {}).get("newton") or {}
+    if not st:
+        return "-"
+    lv = st.get("levels")
+    if lv and lv > 1:
+        return "multigrid, %d levels" % lv
+    return "Cholesky"
+
+
+def agreement_of(d, n):
+    """The agreement check of a pair (stored in the twin's record)."""
+    return (n or {}).get("agreement") or (d or {}).get("agreement") or {}
+
+
+def agreement_text(n, d=None):
+    a = agreement_of(d, n)
     if a.get("max_checked") is None:
         return a.get("reason", "-") if a else "-"
     return "%.1e%s" % (a["max_checked"], "" if a.get("ok") else " **FAIL**")
@@ -754,28 +834,34 @@ def solver_table(key, p, runs, variant):
         skipped = n is not None and n.get("outcome") == "skipped"
         st = (n or {}).get("newton") or {}
         rows.append([
-            d["per_thickness"], particles(d), err(d, q),
+            d["per_thickness"], particles(d), err(n if converged(n) else d, q),
             "%s (%s steps)" % (f3(d.get("wall_seconds"), 1), d.get("steps") or "-"),
             mem(d.get("peak_rss_mb")),
             skip_text(n) if skipped else (f3((n or {}).get("wall_seconds"), 2) if n else
                                           "not run"),
             "-" if skipped or not n else mem(n.get("peak_rss_mb")),
             x_text(speedup(d, n)),
-            "-" if skipped else newton_stats(n),
+            "-" if skipped else newton_stats(n), "-" if skipped else preconditioner_text(n),
             g(st.get("matrix_nonzeros"), 3), g(st.get("factor_nonzeros"), 3),
-            "-" if skipped or not n else agreement_text(n)])
-    L = ["**Damped dynamics against Newton%s** (the Newton twin: the same run with "
-         "`--static.solver=newton`; wall time as the program measures it; memory = peak "
-         "resident set; K = the assembled stiffness' stored entries (lower triangle), factor = "
-         "its Cholesky factor's entries; last column: the largest relative difference of %s "
+            "-" if skipped or not n else agreement_text(n, d)])
+    prim = primary_solver_of(runs, key) or "damped"
+    twin = "damped" if prim == "newton" else "newton"
+    L = ["**Damped dynamics against Newton%s** (the primary run uses the scene's solver, "
+         "%s; its twin is the same run with `--static.solver=%s`; error = the Newton run's "
+         "(the damped one's agrees, last column); wall time as the program measures it; "
+         "memory = peak resident set; K and factor = the stored entries (lower triangle) of "
+         "the matrix CHOLMOD factorises and of its factor: the assembled stiffness with the "
+         "Cholesky preconditioner, the coarsest level with the multigrid; last column: the "
+         "largest relative difference of %s "
          "between the two, which must be below %g x the static tolerance)" % (
              (", " + variant_label(p, variant)) if len(p["variants"]) > 1 else "",
+             prim, twin,
              " and ".join(((p.get("newton") or {}).get("agree") or ["the headline"])),
              (p.get("newton") or {}).get("agreement_factor", 10)), ""]
     L += table(["per thickness", "particles (ghosts)", "error %% (%s)" % q,
                 "damped wall s", "damped memory", "Newton wall s", "Newton memory",
-                "speed-up", "Newton: iterations, CG, factorisations", "K entries",
-                "factor entries", "Newton vs damped (rel.)"], rows)
+                "speed-up", "Newton: iterations, CG, factorisations", "preconditioner",
+                "K entries", "factor entries", "Newton vs damped (rel.)"], rows)
     L.append("")
     L.append(solver_verdict(pairs)[0])
     L.append("")
@@ -804,20 +890,28 @@ def solvers_section(P, runs, meta):
     budget = nm.get("memory_budget_gb", 10.0)
     factor = nm.get("agreement_factor", 10.0)
     L = ["## Static problems: damped dynamics or Newton", ""]
-    L.append("Every static ladder run is repeated with `--static.solver=newton` (Newton-Raphson "
-             "on the tangent stiffness K, conjugate gradients preconditioned by a CHOLMOD "
-             "Cholesky factor of the assembled K; docs/static.md), right after its damped run "
-             "so that both see the same machine load. Both stop at the same out-of-balance "
-             "ratio (the scene's `[static] tolerance`, 1e-5), so they reach the same "
-             "equilibrium: the runner checks that every Newton result differs from the damped "
-             "one by less than %g x the tolerance (relative; `--check` enforces it), and the "
-             "errors against the references are then the same, so the two fronts of error "
-             "against wall time differ only in the wall time. A Newton twin whose predicted "
-             "peak memory exceeds %g GB is not run (the runner's model of the factor's growth, "
-             "anchored at measured runs and updated from the twins it has run; `skipped` "
-             "below). Memory is the peak resident set of the run (the kernel's ru_maxrss), "
-             "wall time the program's own. The machine was shared (load average in the "
-             "header), so ratios within 10 %% are ties." % (factor, budget))
+    prim = {k: primary_solver_of(runs, k) for k, _ in static}
+    newton_first = [short_title(k, p) for k, p in static if prim[k] == "newton"]
+    L.append("Every static ladder run is made with both solvers, right after each other so "
+             "that both see the same machine load: the primary run with the scene's `[static] "
+             "solver` (%s) and its twin with the other one (`--static.solver=...`, run id "
+             "`<primary id>-<solver>`). Newton (docs/static.md) iterates on the tangent "
+             "stiffness K with conjugate gradients, preconditioned by default (`preconditioner "
+             "= auto`) by a geometric multigrid from 15,000 scalar unknowns on (unless a "
+             "Poisson's ratio >= 0.45: Cook's nearly incompressible membrane), else by a "
+             "CHOLMOD Cholesky factor of the assembled K. Both solvers stop at the same "
+             "out-of-balance ratio (the scene's `[static] tolerance`, 1e-5), so they reach the "
+             "same equilibrium: the runner checks that every Newton result differs from the "
+             "damped one by less than %g x the tolerance (relative; `--check` enforces it), "
+             "and the errors against the references are then the same, so the two fronts of "
+             "error against wall time differ only in the wall time. A Newton run whose "
+             "predicted peak memory exceeds %g GB is not run (the runner's memory model, "
+             "anchored at measured runs and updated from the Newton runs it has made; "
+             "`skipped` below). Memory is the peak resident set of the run (the kernel's "
+             "ru_maxrss), wall time the program's own. The machine was shared (load average "
+             "in the header), so ratios within 10 %% are ties." % (
+                 "Newton for %s" % ", ".join(newton_first) if newton_first else
+                 "the damped solver", factor, budget))
     L.append("")
     rows = []
     for key, p in static:
@@ -832,95 +926,68 @@ def solvers_section(P, runs, meta):
     L.append("**Which solver wins, and from which size on** (generated from the tables in "
              "each problem's section; speed-up = damped wall time / Newton wall time)")
     L.append("")
-    L += table(["problem", "verdict", "Newton as the scene's default?"], rows)
+    L += table(["problem", "verdict", "Newton wins everywhere?"], rows)
     L.append("")
     yes = [r[0] for r in rows if r[2] == "**yes**"]
     no = [r[0] for r in rows if r[2] != "**yes**"]
     if yes:
-        L.append("Newton is faster at every ladder size of: %s. The damped solver stays the "
-                 "better default for: %s." % ("; ".join(yes), "; ".join(no) or "none"))
+        L.append("Newton is faster at every ladder size of: %s. Not at every size: %s." % (
+            "; ".join(yes), "; ".join(no) or "none"))
         L.append("")
-    # the sparsity's cost
-    L.append("**What the sparsity of K costs in memory** (default variant of each problem; "
-             "K entries = the stored lower triangle of the assembled stiffness, one entry per "
-             "coupled pair of unknowns: the neighbours of neighbours; factor = the supernodal "
-             "Cholesky factor's entries, 8 bytes each in double precision; the peak resident "
-             "memory of the Newton run holds the factor, K, and the solver's vectors)")
+    # the memory
+    L.append("**What Newton costs in memory** (default variant of each problem; K entries = "
+             "the stored lower triangle of the matrix CHOLMOD factorises, one entry per coupled "
+             "pair of unknowns (the neighbours of neighbours), and factor = its supernodal "
+             "Cholesky factor's entries, 8 bytes each: with the Cholesky preconditioner the "
+             "assembled K itself, with the multigrid its coarsest level (the run's "
+             "summary.json reports that level's), so K per particle is given for the "
+             "Cholesky runs only; the peak resident memory of the Newton run holds K, the "
+             "preconditioner (the factor, or the coarse levels and the MLS transfers) and the "
+             "solver's vectors)")
     L.append("")
-    rows, fits, fac_exp = [], [], {2: [], 3: []}
-    per3, big3, damped_kb = [], [], []  # K entries per particle (3D, 8 through and more),
-    # (particles, fill, factor share of the resident set) of the 3D twins, damped kB/particle
+    rows, fits, ratios = [], [], []
     for key, p in static:
         variant = p["variants"][0]
         pairs = solver_pairs(runs, key, variant)
-        xs, fac, rss_n, rss_d, kk = [], [], [], [], []
+        xs, rss_n = [], []
         for d, n in pairs:
             st = (n or {}).get("newton") or {}
             npart = (d.get("particles") or 0) + (d.get("ghost_particles") or 0)
             if n is not None and n.get("outcome") == "skipped":
                 rows.append([short_title(key, p), d["per_thickness"], particles(d), "-", "-",
-                             "-", "-", "-", skip_text(n), mem(d.get("peak_rss_mb")), "-"])
+                             "-", "-", skip_text(n), mem(d.get("peak_rss_mb")), "-"])
                 continue
             if not st:
                 continue
             nz, fz = st.get("matrix_nonzeros"), st.get("factor_nonzeros")
-            rows.append([short_title(key, p), d["per_thickness"], particles(d), g(nz, 3),
-                         f3(nz / float(d["particles"]), 0) if nz and d.get("particles")
-                         else "-", g(fz, 3), f3(fz / float(nz), 1) if fz and nz else "-",
-                         mem(fz * 8 / 1048576.0) if fz else "-", mem(n.get("peak_rss_mb")),
-                         mem(d.get("peak_rss_mb")),
-                         x_text(n["peak_rss_mb"] / d["peak_rss_mb"])
-                         if n.get("peak_rss_mb") and d.get("peak_rss_mb") else "-"])
-            if p.get("dim") == 3 and d["per_thickness"] >= 8 and nz and d.get("particles"):
-                per3.append(nz / float(d["particles"]))
-            if p.get("dim") == 3 and fz and nz and n.get("peak_rss_mb"):
-                big3.append((npart, fz / float(nz),
-                             fz * 8 / 1048576.0 / n["peak_rss_mb"], short_title(key, p),
-                             d["per_thickness"]))
+            ratio = (n["peak_rss_mb"] / d["peak_rss_mb"]
+                     if n.get("peak_rss_mb") and d.get("peak_rss_mb") else None)
+            chol = preconditioner_text(n) == "Cholesky"
+            rows.append([short_title(key, p), d["per_thickness"], particles(d),
+                         preconditioner_text(n), g(nz, 3),
+                         f3(nz / float(d["particles"]), 0) if chol and nz and d.get("particles")
+                         else "-", g(fz, 3), mem(n.get("peak_rss_mb")),
+                         mem(d.get("peak_rss_mb")), x_text(ratio) if ratio else "-"])
+            if ratio and npart > 20000:
+                ratios.append((ratio, short_title(key, p), d["per_thickness"]))
             xs.append(npart)
-            fac.append(fz)
-            kk.append(nz)
             rss_n.append(n.get("peak_rss_mb"))
-            rss_d.append(d.get("peak_rss_mb"))
-        if len(xs) >= 2:
-            bf = loglog_slope(xs, fac)
-            if bf is not None and p.get("dim") in fac_exp:
-                fac_exp[p["dim"]].append(bf)
-            fits.append("%s: K %s, factor %s, Newton memory %s" % (
-                short_title(key, p),
-                f3(loglog_slope(xs, kk), 2), f3(bf, 2),
-                f3(loglog_slope(xs[1:] if len(xs) > 2 else xs,
-                                rss_n[1:] if len(xs) > 2 else rss_n), 2)))
-    L += table(["problem", "per thickness", "particles (ghosts)", "K entries",
-                "per particle", "factor entries", "fill (factor / K)", "factor values",
-                "Newton peak memory", "damped peak memory", "Newton / damped memory"], rows)
+        if len(xs) >= 3:
+            fits.append("%s %s" % (short_title(key, p),
+                                   f3(loglog_slope(xs[1:], rss_n[1:]), 2)))
+    L += table(["problem", "per thickness", "particles (ghosts)", "preconditioner",
+                "K entries", "per particle", "factor entries", "Newton peak memory",
+                "damped peak memory", "Newton / damped memory"], rows)
     L.append("")
-    if fits:
-        rng = "; ".join("in %dD as N^%.2f to N^%.2f" % (dim, min(v), max(v))
-                        for dim, v in sorted(fac_exp.items(), reverse=True) if v)
-        for key, p in static:
-            for d in ladder(runs, key, p["variants"][0]):
-                if d.get("peak_rss_mb") and d.get("particles", 0) > 20000:
-                    damped_kb.append(d["peak_rss_mb"] * 1024.0 /
-                                     (d["particles"] + (d.get("ghost_particles") or 0)))
-        big3.sort(reverse=True)
-        big = big3[:2]
-        L.append("Growth with the particle count N (particles and ghosts; least-squares "
-                 "exponent b in `~ N^b` over the twins run; the memory's over all but the "
-                 "coarsest, whose resident set is mostly the program itself, about 30 MB): " +
-                 "; ".join(fits) + ". K grows nearly as N: a bounded number of neighbours of "
-                 "neighbours per particle (%s; fewer at coarse sizes, where a larger share of "
-                 "the particles sits at a surface). The factor grows faster, by the fill-in of "
-                 "the elimination: %s over these ladders. The factor, not K, is what costs: "
-                 "%s. The damped solver stores no matrix: its memory grows as N (%s)." % (
-                     "in 3D %.0f-%.0f stored entries per particle from 8 through on" % (
-                         min(per3), max(per3)) if per3 else "-", rng,
-                     "; ".join("%s at %d through (%d particles with ghosts): factor %.1f times "
-                               "K's entries, its values %.0f %% of the run's peak resident "
-                               "memory" % (t, k, n_, fill, 100 * share)
-                               for n_, fill, share, t, k in big) or "-",
-                     "%.1f-%.1f kB per particle with ghosts above 20,000 particles" % (
-                         min(damped_kb), max(damped_kb)) if damped_kb else "-"))
+    if ratios:
+        lo, hi = min(ratios), max(ratios)
+        L.append("Above 20,000 particles Newton needs %.1f (%s, %d through) to %.1f (%s, %d "
+                 "through) times the damped run's memory. Growth of Newton's peak memory with "
+                 "the particle count N (particles and ghosts; least-squares exponent b in "
+                 "`~ N^b` over all but the coarsest run, whose resident set is mostly the "
+                 "program itself): %s. The damped solver stores no matrix: its memory grows "
+                 "as N." % (lo[0], lo[1], lo[2], hi[0], hi[1], hi[2],
+                            "; ".join(fits) or "-"))
         L.append("")
     sk = [r for r in runs if is_newton(r) and r.get("outcome") == "skipped"]
     if sk:
@@ -1220,7 +1287,7 @@ def field_section(key, p, runs):
     """'Field errors against FEM': the `tlsph compare` norms of each ladder run's final
     frame (run.py stores them in the record's `fields`)."""
     recs = [r for r in runs if r["problem"] == key and r["kind"] == "ladder" and
-            isinstance(r.get("fields"), dict) and not is_newton(r)]
+            isinstance(r.get("fields"), dict) and not is_twin(r)]
     if not recs:
         return []
     recs.sort(key=lambda r: (p["variants"].index(r["variant"])
@@ -1377,7 +1444,7 @@ def base_value(p, param):
 
 def base_run(runs, key, p):
     return mid_run(runs, key, p["sensitivity_dx"], p.get("sensitivity_variant",
-                                                          p["variants"][0]))
+                                                          p["variants"][0]), study=True)
 
 
 def sensitivity_section(key, p, runs):
@@ -1526,7 +1593,7 @@ def cuts_section(P, runs):
              "Cook's membranes, plate with a hole) have no sensitivity studies.")
     sk = [r for r in runs if is_newton(r) and r.get("outcome") == "skipped"]
     if sk:
-        L.append("- Newton twins not run because their predicted peak memory exceeds the "
+        L.append("- Newton runs not run because their predicted peak memory exceeds the "
                  "budget (the machine has 24 GB and is shared): %s. The damped solver's runs "
                  "at those sizes are in the tables." % "; ".join(
                      "%s at %d through (%.0f GB predicted)" % (
@@ -1631,7 +1698,9 @@ def solver_plots(plt, np, runs, P, report_dir, colours):
              "solver (circles) and Newton (open diamonds), labelled by particles per "
              "thickness; the errors agree (the twins' check), so a front to the left is the "
              "faster solver at that size. Last panel: peak resident memory of both solvers "
-             "against the particle count (Newton's grows with the Cholesky factor's fill).")]
+             "against the particle count (Newton's: K and the multigrid hierarchy, or the "
+             "Cholesky factor below 15,000 unknowns and for Cook's nearly incompressible "
+             "membrane).")]
 
 
 def make_plots(data, report_dir):
@@ -1664,14 +1733,16 @@ def make_plots(data, report_dir):
             for r, xx, yy in zip(lad, x, y):
                 ax.annotate("%d" % r["per_thickness"], (xx, yy), textcoords="offset points",
                             xytext=(4, 4), fontsize=7, color=colours[i % len(colours)])
-            # the static ladders' Newton front (the twins that ran), same colour, dotted
-            nl = [r for r in ladder(runs, key, variant, solver="newton")
-                  if primary_error(r) is not None and r.get("wall_seconds")]
+            # the static ladders' other front (the twins that ran), same colour, dotted
+            prim = primary_solver_of(runs, key)
+            other = {"newton": "damped", "damped": "newton"}.get(prim)
+            nl = [r for r in ladder(runs, key, variant, solver=other) if is_twin(r) and
+                  primary_error(r) is not None and r.get("wall_seconds")] if other else []
             if nl:
                 ax.loglog([r["wall_seconds"] for r in nl],
                           [max(abs(primary_error(r)), 1e-3) for r in nl], "D:",
                           color=colours[i % len(colours)], mfc="white",
-                          label=short_title(key, p) + " Newton")
+                          label=short_title(key, p) + " " + other)
                 for r in nl:
                     ax.annotate("%d" % r["per_thickness"],
                                 (r["wall_seconds"], max(abs(primary_error(r)), 1e-3)),
@@ -1695,9 +1766,10 @@ def make_plots(data, report_dir):
                 "defaults (the cantilevers' alpha variants are in the alpha-spread table). "
                 "The static cantilever, the clamped plate and the problems with CalculiX "
                 "references only are against the converged FEM values. Static problems: "
-                "solid line = the damped solver (the scenes' default), dotted line with open "
-                "diamonds = Newton (`--static.solver=newton`; same errors, other wall "
-                "times; a size whose Newton run was skipped for memory has no diamond)."))
+                "solid line = the scene's solver (Newton with the multigrid preconditioner "
+                "where the scene says `[static] solver = newton`), dotted line with open "
+                "diamonds = the twin with the other solver (`--static.solver=damped`; same "
+                "errors, other wall times)."))
     out += solver_plots(plt, np, runs, P, report_dir, colours)
 
     # 2. error against dx, with the fitted slope

@@ -30,14 +30,16 @@ are needed for the plots only). Exit status 4 (unstable) or 3 (static run not co
 result to report, not a failure of the runner.
 
 Static problems are solved twice at every ladder resolution: with the scene's solver (the
-damped dynamics, `[static] solver = damped`) and again with `--static.solver=newton` (a
-"Newton twin", id `<ladder id>-newton`, record field `solver`). A twin is skipped, and recorded
-as skipped, when its predicted peak memory exceeds --newton-memory-gb (default 10 GB: the
-Cholesky factor grows faster than the particle count, see NEWTON_MEMORY below). Each twin's
-result must agree with its damped run: the relative difference of the problem's headline
-values below NEWTON_AGREEMENT times the static tolerance (--check enforces it; the quick check
-runs a few tiny twins). Every run's peak resident memory is measured (wait4's ru_maxrss), and a
-run above --memory-limit-gb is stopped.
+primary run; the static scenes say `[static] solver = newton`) and again with the other solver
+(a "twin": `--static.solver=damped`, id `<ladder id>-damped`; record fields `solver`, `twin`,
+`twin_of`). Their sensitivity studies keep the damped solver (`--static.solver=damped`: the
+time.cfl study is about the damped dynamics). A Newton run (primary or twin) is skipped, and
+recorded as skipped, when its predicted peak memory exceeds --newton-memory-gb (default 10 GB;
+the memory model NEWTON_MEMORY below, measured with the multigrid preconditioner). Each twin's
+result must agree with its primary: the relative difference of the problem's headline values
+below NEWTON_AGREEMENT times the static tolerance (--check enforces it; the quick check runs a
+few small twins). Every run's peak resident memory is measured (wait4's ru_maxrss), and a run
+above --memory-limit-gb is stopped.
 
 Running, parsing and checking use the Python standard library only (CI has no numpy).
 """
@@ -554,7 +556,7 @@ class Problem:
     def __init__(self, key, title, scene, dim, thickness, ladder, quick_dx, sens_dx, extract,
                  static, qoi, unit, target=None, variants=None, sensitivity=None,
                  checked=None, cross=None, quick_variant=0, sens_variant=0,
-                 variant_ladders=None, clamps=None, newton_memory=None, quick_newton=False,
+                 variant_ladders=None, clamps=None, newton_memory=None, quick_twin=False,
                  agree=None):
         self.key, self.title, self.scene, self.dim = key, title, scene, dim
         self.thickness, self.ladder = thickness, ladder
@@ -569,11 +571,11 @@ class Problem:
         self.sens_variant = sens_variant  # the variant the sensitivity studies start from
         self.variant_ladders = variant_ladders or {}  # variant -> its own (shorter) ladder
         self.clamps = clamps or []  # the scene's [clamp.NAME] sections (the clamp.method study)
-        # static problems: the Newton twins' memory model (n_ref per thickness, peak GB there,
+        # static problems: the Newton runs' memory model (n_ref per thickness, peak GB there,
         # exponent of n; NEWTON_MEMORY), whether the quick check runs the quick run's twin, and
         # the values (qoi["values"]) whose Newton-damped agreement is checked
         self.newton_memory = newton_memory
-        self.quick_newton = quick_newton
+        self.quick_twin = quick_twin
         self.agree = agree or []
 
 
@@ -611,27 +613,39 @@ ALPHA_VARIANTS = [("alpha1", {"hourglass.alpha": "1"}), ("alpha30", {"hourglass.
 DYNAMIC_ALPHA_LADDER = [0.025, 0.0125]  # 10 through cut (budget)
 STATIC_ALPHA_LADDER = [0.025, 0.0125, 0.01, 0.1 / 12]  # 16 through cut (budget)
 
-# Newton twins of the static ladders (`--static.solver=newton`). Their memory is the sparse
-# Cholesky factor of the assembled stiffness: it grows faster than the particle count, so each
-# static problem has a model of the peak resident memory, GB(n) = GB_ref (n / n_ref)^exponent
-# (n = particles per thickness), anchored at a run measured with /usr/bin/time on the 2-core
-# machine (commit 259a8de, 2 threads, 2026-11-28; the clamped plate's from docs/static.md:
-# 0.46, 2.4, 7.8 GB at 4, 6, 8 through, exponent 4.1 in n). The runner predicts each twin's
-# memory from the finest twin of the same problem it has measured so far (else from this
-# anchor), with the larger of the model's exponent and the one observed between the two
-# finest measured twins, and skips the twin when the prediction exceeds --newton-memory-gb.
+# The static problems' Newton runs (the primaries since the multigrid preconditioner; and the
+# twins of a scene whose solver is damped) and their memory. With `[static] preconditioner =
+# auto` Newton stores the assembled stiffness K and either the CHOLMOD factor (below 15,000
+# scalar unknowns, or Poisson's ratio >= 0.45: Cook's nearly incompressible membrane) or the
+# multigrid hierarchy (K's Galerkin coarse levels and the MLS transfers), whose size grows about
+# as the particle count N (measured: Newton's peak memory ~ N^0.97-1.17 over the 3D ladders,
+# 2.1-2.7 times the damped run's above 20,000 particles). Each static problem has a model of
+# the peak resident memory, GB(n) = GB_ref (n / n_ref)^exponent (n = particles per
+# thickness), anchored at the finest Newton run of the problem measured by the runner (wait4
+# ru_maxrss; 2 threads on the 2-core machine, binary of commit 27c1e8e, 2026-11-29; the full
+# validation of the solver reversal). Exponent in 3D: the one between the two finest runs of
+# the problem (3.0-3.4: N grows as n^3 and slightly faster); in 2D 2.5, a bound (the finest
+# runs grow as n^1.5-1.7; the Cholesky factor as N log N). The runner predicts each Newton
+# run's memory from the finest Newton run of the
+# same problem it has measured so far (else from this anchor), with the larger of the model's
+# exponent and the one observed between the two finest measured runs when both exceed
+# MEMORY_FLOOR_GB (below that the program's fixed size and the switch between the Cholesky
+# factor and the multigrid dominate), and skips the run when the prediction exceeds
+# --newton-memory-gb.
 NEWTON_BUDGET_GB = 10.0
 MEMORY_LIMIT_GB = 10.5  # any run (damped or Newton) above this resident size is stopped
-NEWTON_MEMORY = {
-    "cantilever_static": (12, 1.57, 4.5),  # 0.31, 0.69, 1.57, 5.58 GB at 8, 10, 12, 16
-    "cantilever_large": (8, 0.32, 4.5),
-    "clamped_plate": (8, 7.8, 4.1),
-    "csm1": (16, 0.056, 2.5),  # 2D: the factor grows about as N log N; 2.5 is a bound
-    "cook_membrane": (32, 0.12, 2.5),
-    "cook_membrane_incompressible": (32, 0.12, 2.5),
-    "plate_hole": (16, 0.38, 2.5),
+MEMORY_FLOOR_GB = 0.5
+NEWTON_MEMORY = {  # measured peak resident memory of the Newton runs (multigrid from 15,000
+    # unknowns), GB: 0.045, 0.11, 0.24, 0.35, 0.91 at 4, 8, 10, 12, 16 through
+    "cantilever_static": (16, 0.91, 3.3),
+    "cantilever_large": (10, 0.24, 3.4),  # 0.045, 0.11, 0.24 at 4, 8, 10
+    "clamped_plate": (16, 7.6, 3.0),  # 0.15, 0.50, 1.28, 1.87, 7.6 at 4, 6, 8, 10, 16
+    "csm1": (16, 0.062, 2.5),  # Cholesky at every size (at most 9,056 unknowns)
+    "cook_membrane": (32, 0.13, 2.5),  # Cholesky at every size (at most 12,020 unknowns)
+    "cook_membrane_incompressible": (32, 0.12, 2.5),  # Cholesky (nu = 0.4999)
+    "plate_hole": (32, 0.65, 2.5),  # 0.10, 0.20, 0.65 at 8, 16, 32 (Cholesky at 8)
 }
-# A twin agrees with its damped run when every checked value differs by less than
+# A twin agrees with its primary when every checked value differs by less than
 # NEWTON_AGREEMENT times the static tolerance (relative): both stop at an out-of-balance ratio
 # below the tolerance, and the displacement error that leaves is of the same order (measured:
 # 1e-7 to 4e-5 relative at tolerance 1e-5).
@@ -656,7 +670,7 @@ PROBLEMS = [
                               "time.cfl": CFL, "static.tolerance": TOL},
                              **hourglass_studies(True)),
             checked=["tip_vs_fem", "tip", "tip_extrapolated"], clamps=["root"],
-            newton_memory=NEWTON_MEMORY["cantilever_static"], quick_newton=True,
+            newton_memory=NEWTON_MEMORY["cantilever_static"], quick_twin=True,
             agree=["tip"]),
     Problem("cantilever_dynamic", "Cantilever, gravity applied suddenly, 3D",
             "cantilever_dynamic.ini", 3, 0.1, [0.025, 0.0125, 0.01], 0.025, 0.025,
@@ -676,7 +690,7 @@ PROBLEMS = [
                               "time.cfl": CFL, "static.tolerance": TOL},
                              **hourglass_studies(True)),
             checked=["displacement", "ux", "uy"], clamps=["root"],
-            newton_memory=NEWTON_MEMORY["csm1"], quick_newton=True, agree=["ux", "uy"]),
+            newton_memory=NEWTON_MEMORY["csm1"], quick_twin=True, agree=["ux", "uy"]),
     Problem("csm3", "Turek & Hron CSM3, dynamic, 2D", "turek_hron_csm3.ini", 2, 0.02,
             [0.005, 0.0025, 0.00125], 0.005, 0.0025, extract_csm3, False,
             "frequency", "Hz", target=("frequency", 2.0),
@@ -701,7 +715,7 @@ PROBLEMS = [
             "cantilever_large.ini", 3, 0.1, [0.025, 0.0125, 0.01], 0.025, 0.025,
             extract_cantilever_large, True, "tip displacement u_z", "m",
             checked=["tip_uz", "tip_ux"], clamps=["root"],
-            newton_memory=NEWTON_MEMORY["cantilever_large"], quick_newton=True,
+            newton_memory=NEWTON_MEMORY["cantilever_large"], quick_twin=True,
             agree=["tip_uz", "tip_ux"]),
     Problem("cook_membrane", "Cook's membrane, plane strain, nu = 0.3, static, 2D",
             "cook_membrane.ini", 2, 0.016, [0.002, 0.001, 0.0005], 0.002, 0.002,
@@ -713,7 +727,7 @@ PROBLEMS = [
             "cook_membrane_incompressible.ini", 2, 0.016, [0.002, 0.001, 0.0005], 0.002, 0.002,
             extract_cook("cook_membrane_incompressible"), True, "corner displacement u_y", "m",
             checked=["corner_uy", "corner_ux"], clamps=["left"],
-            newton_memory=NEWTON_MEMORY["cook_membrane_incompressible"], quick_newton=True,
+            newton_memory=NEWTON_MEMORY["cook_membrane_incompressible"], quick_twin=True,
             agree=["corner_uy", "corner_ux"]),
     Problem("plate_hole", "Plate with a central hole in tension, plane strain, static, 2D",
             "plate_hole.ini", 2, 0.02, [0.0025, 0.00125, 0.000625], 0.0025, 0.0025,
@@ -745,7 +759,9 @@ def per_thickness(problem, dx):
     return int(round(problem.thickness / dx))
 
 
-def run_id(problem, variant, dx, param=None, value=None, solver=None):
+def run_id(problem, variant, dx, param=None, value=None, twin=None):
+    """The run's id (its directory name): problem, variant, particles per thickness, the
+    sensitivity value, and for a static ladder's twin the twin's solver."""
     parts = [problem.key]
     if variant:
         parts.append(variant)
@@ -754,8 +770,8 @@ def run_id(problem, variant, dx, param=None, value=None, solver=None):
         parts += ["%s%s" % (SHORT[k], fmt(v)) for k, v in value.items()]
     elif param:
         parts.append("%s%s" % (SHORT[param], fmt(value)))
-    if solver == "newton":
-        parts.append("newton")
+    if twin:
+        parts.append(twin)
     return "-".join(parts)
 
 
@@ -767,30 +783,62 @@ def study_overrides(problem, param, value):
     return {param: "%g" % value if param == "static.tolerance" else fmt(value)}
 
 
-def plan_runs(quick, sensitivity, only, newton=True):
-    """The runs to do, in order: ladders (coarse to fine; a static problem's Newton twin right
-    after its damped run, under the same machine load), then sensitivities. A sensitivity
-    run with the same settings as a ladder run (an alpha variant at the sensitivity
-    resolution) is not run twice: the report takes the ladder run. The quick plan has the
-    twins of the problems marked quick_newton only (tiny runs)."""
+SOLVERS = ("damped", "newton")
+SENSITIVITY_SOLVER = "damped"  # the static problems' sensitivity studies (see the docstring)
+
+
+def primary_solver(problem):
+    """The static solver of a static problem's scene ([static] solver; the program's default
+    is damped), None for a dynamic problem."""
+    if not problem.static:
+        return None
+    v = scene_value(ROOT / "validation" / "scenes" / problem.scene, "static", "solver")
+    v = (v or "damped").lower()
+    if v not in SOLVERS:
+        raise SystemExit("%s: [static] solver = %s (one of %s)" % (problem.scene, v,
+                                                                   ", ".join(SOLVERS)))
+    return v
+
+
+def other_solver(solver):
+    return "damped" if solver == "newton" else "newton"
+
+
+def plan_runs(quick, sensitivity, only, twins=True):
+    """The runs to do, in order: ladders (coarse to fine; a static problem's twin, the same run
+    with the other solver, right after its primary run, under the same machine load), then
+    sensitivities (a static problem's with SENSITIVITY_SOLVER). A sensitivity run with the same
+    settings as a ladder run (an alpha variant's damped twin at the sensitivity resolution) is
+    not run twice: the report takes the ladder run. The quick plan has the twins of the
+    problems marked quick_twin only."""
     runs = []
 
     def ladder_run(p, name, ov, dx, with_twin):
-        solver = "damped" if p.static else None
+        solver = primary_solver(p)
         runs.append(dict(problem=p.key, variant=name, dx=dx, kind="ladder", param=None,
-                         value=None, overrides=dict(ov), solver=solver))
-        if p.static and newton and with_twin:
+                         value=None, overrides=dict(ov), solver=solver, twin=None))
+        if p.static and twins and with_twin:
             o = dict(ov)
-            o["static.solver"] = "newton"
+            o["static.solver"] = other_solver(solver)
             runs.append(dict(problem=p.key, variant=name, dx=dx, kind="ladder", param=None,
-                             value=None, overrides=o, solver="newton"))
+                             value=None, overrides=o, solver=o["static.solver"],
+                             twin=o["static.solver"]))
+
+    def study_solver(p, o):
+        """A static problem's sensitivity run: SENSITIVITY_SOLVER, given explicitly when the
+        scene's solver is another."""
+        if not p.static:
+            return None
+        if primary_solver(p) != SENSITIVITY_SOLVER:
+            o["static.solver"] = SENSITIVITY_SOLVER
+        return SENSITIVITY_SOLVER
 
     for p in PROBLEMS:
         if only and p.key not in only:
             continue
         if quick:
             name, ov = p.variants[p.quick_variant]
-            ladder_run(p, name, ov, p.quick_dx, p.quick_newton)
+            ladder_run(p, name, ov, p.quick_dx, p.quick_twin)
             continue
         for name, ov in p.variants:
             for dx in p.variant_ladders.get(name, p.ladder):
@@ -805,39 +853,42 @@ def plan_runs(quick, sensitivity, only, newton=True):
                 for v in values:
                     o = dict(ov)
                     o.update(study_overrides(p, param, v))
+                    solver = study_solver(p, o)
                     if (p.key, p.sens_dx, tuple(sorted(o.items()))) in done:
                         continue
                     runs.append(dict(problem=p.key, variant=name, dx=p.sens_dx,
                                      kind="sensitivity", param=param, value=v, overrides=o,
-                                     solver="damped" if p.static else None))
+                                     solver=solver))
             for combo in p.cross:
                 o = dict(ov)
                 o.update({k: fmt(v) for k, v in combo.items()})
+                solver = study_solver(p, o)
                 runs.append(dict(problem=p.key, variant=name, dx=p.sens_dx, kind="cross",
                                  param="+".join(combo), value=dict(combo), overrides=o,
-                                 solver="damped" if p.static else None))
+                                 solver=solver))
     for r in runs:
         p = BY_KEY[r["problem"]]
-        r["id"] = run_id(p, r["variant"], r["dx"], r["param"], r["value"], r.get("solver"))
-        if r.get("solver") == "newton":
-            r["damped_twin"] = run_id(p, r["variant"], r["dx"], r["param"], r["value"])
+        r["id"] = run_id(p, r["variant"], r["dx"], r["param"], r["value"], r.get("twin"))
+        if r.get("twin"):
+            r["twin_of"] = run_id(p, r["variant"], r["dx"], r["param"], r["value"])
     return runs
 
 
 # --------------------------------------------------------------------------------------------
-# Newton twins: memory prediction and agreement with the damped run
+# Newton runs' memory prediction; a twin's agreement with its primary
 
 
 def predict_newton_gb(problem, n, measured):
-    """Predicted peak resident memory [GB] of the problem's Newton twin at n per thickness,
-    and how it was predicted. measured: [(n, GB)] of the problem's twins measured so far."""
+    """Predicted peak resident memory [GB] of the problem's Newton run at n per thickness,
+    and how it was predicted. measured: [(n, GB)] of the problem's Newton runs measured so
+    far."""
     n0, gb0, expo = problem.newton_memory or (None, None, None)
     pts = sorted((m, gb) for m, gb in measured if gb)
     basis = "model %g GB at %d through, exponent %g" % (gb0, n0, expo) if n0 else None
     if pts:
         n1, gb1 = pts[-1]
-        lower = [q for q in pts if q[0] < n1]
-        if lower and expo is not None:
+        lower = [q for q in pts if q[0] < n1 and q[1] > MEMORY_FLOOR_GB]
+        if lower and expo is not None and gb1 > MEMORY_FLOOR_GB:
             obs = math.log(gb1 / lower[-1][1]) / math.log(n1 / lower[-1][0])
             expo = max(expo, obs)
         elif expo is None:
@@ -870,10 +921,13 @@ def static_tolerance(problem, run):
 
 
 def agreement(problem, newton_rec, damped_rec):
-    """The Newton twin's values against its damped run's: relative differences of every value
-    and the check of the problem's agree-values against NEWTON_AGREEMENT x the tolerance."""
+    """The Newton run's values against the damped run's (one is the primary, the other its
+    twin): relative differences (Newton - damped) / |damped| of every value and the check of
+    the problem's agree-values against NEWTON_AGREEMENT x the tolerance; both runs must have
+    converged."""
     tol = static_tolerance(problem, damped_rec)
-    out = {"damped_run": damped_rec["id"], "static_tolerance": tol,
+    out = {"damped_run": damped_rec["id"], "newton_run": newton_rec["id"],
+           "static_tolerance": tol,
            "limit": NEWTON_AGREEMENT * tol, "checked": {}, "relative_differences": {}}
     qn, qd = newton_rec.get("qoi"), damped_rec.get("qoi")
     if not qn or not qd:
@@ -892,7 +946,8 @@ def agreement(problem, newton_rec, damped_rec):
     vals = list(out["checked"].values())
     out["max_checked"] = max(abs(v) for v in vals) if vals and None not in vals else None
     out["ok"] = bool(out["max_checked"] is not None and out["max_checked"] <= out["limit"] and
-                     newton_rec.get("outcome") == "converged")
+                     newton_rec.get("outcome") == "converged" and
+                     damped_rec.get("outcome") == "converged")
     return out
 
 
@@ -982,10 +1037,10 @@ FIELD_OUTPUT = "displacement cauchy_stress flags"
 
 
 def wants_fields(problem, run):
-    """Field comparison with the FEM: ladder runs of the static problems that have an FEM
-    VTU, in the full validation only (the quick check writes no frames)."""
+    """Field comparison with the FEM: ladder runs (primaries and twins) of the static problems
+    that have an FEM VTU, in the full validation only (the quick check writes no frames)."""
     return bool(run.get("compare_fields") and run["kind"] == "ladder" and
-                problem.key in FIELD_PROBLEMS and run.get("solver") != "newton")
+                problem.key in FIELD_PROBLEMS)
 
 
 def build_command(problem, run, build_dir, runs_dir):
@@ -1088,6 +1143,8 @@ def execute(problem, run, build_dir, runs_dir, R, git, reuse, timeout,
                            peak_rss_mb=old.get("peak_rss_mb"))
                 if old.get("stderr"):
                     rec["stderr"] = old["stderr"]
+                if old.get("adopted_from"):  # a run renamed to the id it now has
+                    rec["adopted_from"] = old["adopted_from"]
                 reused = True
         except (OSError, ValueError):
             pass
@@ -1245,10 +1302,13 @@ def problems_table():
                     "sensitivity_variant": p.variants[p.sens_variant][0],
                     "variant_ladders": p.variant_ladders,
                     "sensitivity": p.sensitivity, "cross": p.cross,
+                    "solver": primary_solver(p),
                     "newton": ({"memory_model": dict(zip(("n_ref", "gb_ref", "exponent"),
                                                          p.newton_memory))
                                 if p.newton_memory else None,
-                                "agree": p.agree, "quick": p.quick_newton,
+                                "agree": p.agree, "quick": p.quick_twin,
+                                "twin_solver": other_solver(primary_solver(p)),
+                                "sensitivity_solver": SENSITIVITY_SOLVER,
                                 "agreement_factor": NEWTON_AGREEMENT}
                                if p.static else None)}
             for p in PROBLEMS}
@@ -1293,21 +1353,25 @@ def derive_tolerances(results, path):
 
 
 def check_agreement(records):
-    """Returns (rows, ok): each Newton twin's agreement with its damped run (execute() stored
-    it in the twin's record). rows: (run id, value, relative difference, limit, verdict). A
-    twin skipped for memory is no failure; one that ran and does not agree (or did not
-    converge) is."""
+    """Returns (rows, ok): each twin's agreement with its primary (main() stored it in the
+    twin's record). rows: (run id, value, relative difference Newton - damped, limit,
+    verdict). A pair with a run skipped for memory is no failure; a pair that ran and does not
+    agree (or did not converge) is."""
     rows, ok = [], True
+    by_id = {r["id"]: r for r in records}
     for r in records:
-        if r.get("solver") != "newton" or r.get("outcome") == "skipped":
+        if not r.get("twin"):
+            continue
+        prim = by_id.get(r.get("twin_of")) or {}
+        if r.get("outcome") == "skipped" or prim.get("outcome") == "skipped":
             continue
         a = r.get("agreement") or {}
         if not a.get("checked"):
             rows.append((r["id"], "-", None, a.get("limit"),
-                         "FAIL (%s)" % (a.get("reason") or "no damped run to compare with")))
+                         "FAIL (%s)" % (a.get("reason") or "no primary run to compare with")))
             ok = False
             continue
-        conv = r.get("outcome") == "converged"
+        conv = r.get("outcome") == "converged" and prim.get("outcome") == "converged"
         for name, d in a["checked"].items():
             good = d is not None and abs(d) <= a["limit"] and conv
             ok &= good
@@ -1431,10 +1495,10 @@ def main(argv=None):
                          "newer than its scene file (for development and for resuming an "
                          "interrupted ladder: the binary and commit are not compared)")
     ap.add_argument("--timeout", type=float, default=3600.0, help="seconds per run")
-    ap.add_argument("--no-newton", action="store_true",
-                    help="no Newton twins of the static ladders")
+    ap.add_argument("--no-twins", "--no-newton", dest="no_twins", action="store_true",
+                    help="no twins of the static ladders (the runs with the other solver)")
     ap.add_argument("--newton-memory-gb", type=float, default=NEWTON_BUDGET_GB,
-                    help="skip a Newton twin whose predicted peak memory exceeds this "
+                    help="skip a Newton run whose predicted peak memory exceeds this "
                          "(default %(default)s GB)")
     ap.add_argument("--memory-limit-gb", type=float, default=MEMORY_LIMIT_GB,
                     help="stop any run whose resident memory exceeds this (default "
@@ -1476,7 +1540,7 @@ def main(argv=None):
 
     runs_dir = Path(args.runs_dir) if args.runs_dir else (
         HERE / "runs" / "quick" if args.quick else HERE / "runs")
-    plan = plan_runs(args.quick, not args.no_sensitivity, only, not args.no_newton)
+    plan = plan_runs(args.quick, not args.no_sensitivity, only, not args.no_twins)
     for r in plan:
         r["threads"] = args.threads
         r["wait_policy"] = args.omp_wait_policy
@@ -1524,7 +1588,10 @@ def main(argv=None):
             "machine": machine_info(args.threads, args.build_dir),
             "omp_wait_policy": args.omp_wait_policy,
             "quick": args.quick, "fem": fem_info,
-            "newton": {"twins": not args.no_newton, "memory_budget_gb": args.newton_memory_gb,
+            "newton": {"twins": not args.no_twins, "memory_budget_gb": args.newton_memory_gb,
+                       "primary_solver": {p.key: primary_solver(p) for p in PROBLEMS
+                                          if p.static},
+                       "sensitivity_solver": SENSITIVITY_SOLVER,
                        "memory_limit_gb": args.memory_limit_gb,
                        "agreement_factor": NEWTON_AGREEMENT,
                        "memory_measure": "peak resident set of each run (wait4 ru_maxrss)"}}
@@ -1572,12 +1639,14 @@ def main(argv=None):
                           args.memory_limit_gb)
             if r.get("solver") == "newton":
                 rec["predicted_memory_gb"], rec["memory_prediction"] = gb, basis
-                twin = by_id.get(r["damped_twin"])
-                if twin is not None:
-                    rec["agreement"] = agreement(p, rec, twin)
-                else:
-                    rec["agreement"] = {"ok": False, "reason": "damped run %s not in this "
-                                        "invocation" % r["damped_twin"]}
+        if r.get("twin"):
+            prim = by_id.get(r["twin_of"])
+            if prim is None:
+                rec["agreement"] = {"ok": False, "reason": "primary run %s not in this "
+                                    "invocation" % r["twin_of"]}
+            elif "skipped" not in (rec.get("outcome"), prim.get("outcome")):
+                nd = (rec, prim) if rec.get("solver") == "newton" else (prim, rec)
+                rec["agreement"] = agreement(p, *nd)
         records.append(rec)
         by_id[rec["id"]] = rec
         q = rec.get("qoi")
@@ -1587,7 +1656,7 @@ def main(argv=None):
             extra = "  " + rec["skipped"]
         elif rec.get("agreement"):
             a = rec["agreement"]
-            extra = "  vs damped: %s" % (
+            extra = "  newton vs damped: %s" % (
                 "max %.1e (limit %.0e) %s" % (a["max_checked"], a["limit"],
                                               "ok" if a["ok"] else "FAIL")
                 if a.get("max_checked") is not None else a.get("reason", "FAIL"))
@@ -1626,7 +1695,7 @@ def main(argv=None):
         arows, aok = check_agreement(records)
         if arows:
             print()
-            print("%-36s %-26s %10s %10s  %s" % ("Newton twin", "value", "rel. diff",
+            print("%-36s %-26s %10s %10s  %s" % ("twin", "value", "Newton-damped",
                                                  "limit", "verdict"))
             for rid, name, d, lim, verdict in arows:
                 print("%-36s %-26s %10s %10s  %s" % (
