@@ -726,11 +726,12 @@ def speedup(d, n):
 
 
 def mem(mb):
+    """Peak resident memory, given in MiB (ru_maxrss / 1024), in binary units."""
     if not mb:
         return "-"
     if mb < 10:
-        return "%.1f MB" % mb
-    return "%.0f MB" % mb if mb < 1000 else "%.2f GB" % (mb / 1024.0)
+        return "%.1f MiB" % mb
+    return "%.0f MiB" % mb if mb < 1000 else "%.2f GiB" % (mb / 1024.0)
 
 
 def x_text(sp):

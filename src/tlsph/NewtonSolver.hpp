@@ -63,8 +63,10 @@ struct NewtonStatistics {
   int iterations = 0;         // Newton iterations in all
   long krylovIterations = 0;  // conjugate-gradient iterations in all
   int factorisations = 0;
-  long nonZeros = 0;        // stored entries of the assembled matrix (lower triangle)
-  long factorNonZeros = 0;  // stored entries of its Cholesky factor
+  // Stored entries of the assembled matrix (lower triangle) and of its Cholesky factor; with
+  // the multigrid, the coarsest level's (the fine K is never assembled).
+  long nonZeros = 0;
+  long factorNonZeros = 0;
   int levels = 1;           // multigrid levels (1: the Cholesky factor of the whole matrix)
   double assemblySeconds = 0.0, factorisationSeconds = 0.0, solveSeconds = 0.0;
   std::string linearSolver;
