@@ -69,9 +69,15 @@ OutputEstimate estimateOutput(const SceneSetup<D>& setup, double timeStep) {
   e.seriesRows = static_cast<long>(
       std::min(run.newtonStatic() ? steps : steps / double(out.seriesEverySteps), 1e12) + 2);
   e.seriesBytes = e.seriesRows * columns * 24.0;
-  // Displacement, velocity (and the force pass's velocity), and the Newton factor's F.
+  // Displacement, velocity (and the force pass's velocity), the Newton preconditioner's F and,
+  // when it may be the multigrid, its displacements and Taylor second gradients (D x D(D+1)/2).
+  const bool multigrid =
+      run.newtonStatic() && run.newton.preconditioner != NewtonPreconditioner::Cholesky;
+  const double secondGradients =
+      setup.scene.quadrature == Quadrature::Taylor ? D * D * (D + 1) / 2.0 : 0.0;
   e.checkpointBytes = n * D * 8.0 * (setup.scene.viscosity.enabled() ? 3.0 : 2.0) +
-                      (run.newtonStatic() ? n * D * D * 8.0 : 0.0) + 65536.0;
+                      (run.newtonStatic() ? n * D * D * 8.0 : 0.0) +
+                      (multigrid ? n * (D + secondGradients) * 8.0 : 0.0) + 65536.0;
   e.checkpointsKept = setup.checkpoint.keep;
   return e;
 }
