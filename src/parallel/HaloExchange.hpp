@@ -1,0 +1,55 @@
+// The static communication plan of one MPI rank (issue 11), built once from the partition:
+// what it receives from each neighbour rank (its halo, the particles of other ranks its own
+// particles read) and what it sends (its particles in their halos), both in ascending global
+// index on either side, so no index travels. One exchange is one MPI neighbourhood
+// all-to-all over a distributed-graph communicator of the ranks that share a halo.
+//
+// Arrays are indexed by global particle index for now: a rank fills its own entries, and
+// exchange() fills its halo entries with the owners' values, leaving every other entry as it
+// was.
+#pragma once
+
+#include <mpi.h>
+
+#include <cstring>
+#include <type_traits>
+#include <vector>
+
+#include "tlsph/DomainPartition.hpp"
+
+namespace tlsph {
+
+class HaloExchange {
+ public:
+  // Every rank passes the same partition (built identically from the same scene); its number of
+  // parts must be the communicator's size.
+  HaloExchange(MPI_Comm comm, const DomainPartition& partition);
+  ~HaloExchange();
+  HaloExchange(const HaloExchange&) = delete;
+  HaloExchange& operator=(const HaloExchange&) = delete;
+
+  int rank() const { return rank_; }
+  const std::vector<int>& neighbours() const { return neighbours_; }
+  std::size_t haloCount() const { return receiveIndex_.size(); }
+  std::size_t sendCount() const { return sendIndex_.size(); }
+
+  // T: plain data (numbers; fixed-size Eigen vectors and matrices, arrays of doubles).
+  template <class T>
+  void exchange(std::vector<T>& values) {
+    static_assert(std::is_trivially_destructible_v<T>);
+    exchangeBytes(reinterpret_cast<char*>(values.data()), sizeof(T));
+  }
+
+ private:
+  void exchangeBytes(char* values, std::size_t size);
+
+  MPI_Comm graph_ = MPI_COMM_NULL;
+  int rank_ = 0;
+  std::vector<int> neighbours_;
+  // Per neighbour (in neighbours_ order): counts and offsets into the flat index lists.
+  std::vector<int> sendCounts_, sendOffsets_, receiveCounts_, receiveOffsets_;
+  std::vector<Index> sendIndex_, receiveIndex_;
+  std::vector<char> sendBuffer_, receiveBuffer_;
+};
+
+}  // namespace tlsph
