@@ -361,6 +361,64 @@ TEST(Multigrid, AutoFallsBackToTheFactorWhenItsIterationStalls) {
   EXPECT_LT(difference, 1e-5 * scale);
 }
 
+TEST(Multigrid, AThinBodyWithoutACoarseLevelKeepsTheFactor) {
+  // Two particles through the thickness: at twice the spacing one, where the correction tensor
+  // is singular. auto runs with the factor; multigrid asked for is refused, saying why.
+  const std::string thin = R"([scene]
+dimension = 3
+dx = 0.0125
+[material.plate]
+model = saint-venant-kirchhoff
+density = 1000
+youngs_modulus = 1.0e7
+poisson_ratio = 0.3
+[body.plate]
+shape = box
+lower = 0 0 0
+upper = 0.3 0.3 0.025
+[clamp.left]
+face = x-
+[clamp.right]
+face = x+
+[load.pressure]
+face = z+
+type = traction
+value = 0 0 -10
+ramp = 0.005
+[static]
+solver = newton
+[time]
+end = 1
+[output]
+fields = none
+)";
+  auto setup = [&](const std::string& preconditioner) {
+    SceneSetup<3> s = buildScene<3>(Config::parse(
+        thin, "thin.ini",
+        {"--static.preconditioner=" + preconditioner,
+         "--output.directory=" + (fs::temp_directory_path() / "tlsph_multigrid_thin").string()}));
+    s.run.newton.autoMultigridUnknowns = 100;
+    return s;
+  };
+  SceneSetup<3> automatic = setup("auto");
+  fs::remove_all(fs::temp_directory_path() / "tlsph_multigrid_thin");
+  const RunSummary r = runSimulation(automatic, RunOptions{}, [](const Solver<3>&) {});
+  fs::remove_all(fs::temp_directory_path() / "tlsph_multigrid_thin");
+  ASSERT_TRUE(r.newton);
+  EXPECT_EQ(r.outcome, RunOutcome::Converged);
+  EXPECT_EQ(r.newton->levels, 1);
+  SceneSetup<3> asked = setup("multigrid");
+  Solver<3> solver(asked.scene, asked.solver);
+  try {
+    NewtonSolver<3> newton(asked.scene, solver, asked.run.newton, asked.coarsen, asked.solver);
+    FAIL() << "a multigrid without a coarse level was accepted";
+  } catch (const SetupError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("twice its particle spacing"), std::string::npos) << m;
+    EXPECT_NE(m.find("preconditioner = cholesky"), std::string::npos) << m;
+  }
+}
+
 TEST(Multigrid, GivesBitwiseEqualResultsOnAnyThreadCount) {
   // The diagonal blocks, the Lanczos bound and the interpolations are all summed in a fixed
   // order: the same iterations and the same bits on 1 and 3 threads.

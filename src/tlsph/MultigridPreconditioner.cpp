@@ -89,7 +89,15 @@ MultigridPreconditioner<D>::MultigridPreconditioner(const Scene<D>& fine, const 
     auto level = std::make_unique<Level>();
     level->scene = std::move(scene);
     Scene<D>& s = *level->scene;
-    level->solver = std::make_unique<Solver<D>>(s, settings);
+    // A level too coarse for the geometry (a correction tensor singular through a thin body):
+    // the levels above it serve; none at all is the caller's to handle.
+    try {
+      level->solver = std::make_unique<Solver<D>>(s, settings);
+    } catch (const SetupError& e) {
+      if (levels_.size() == 1)
+        throw SetupError(std::string("the scene at twice its particle spacing: ") + e.what());
+      break;
+    }
     level->ownDofs = std::make_unique<DofMap<D>>(s.particles, s.mirrorGhosts);
     level->dofs = level->ownDofs.get();
     level->ownTangent = std::make_unique<TangentStiffness<D>>(

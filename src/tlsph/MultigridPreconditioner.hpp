@@ -36,7 +36,8 @@ class MultigridPreconditioner {
   static constexpr double kSmoothedRatio = 10.0;
 
   // `fine` with its unknowns and exact tangent (owned by the Newton solver); `coarse`: the
-  // coarser scenes, finest first, the last one solved directly.
+  // coarser scenes, finest first, the last one solved directly. A coarse scene whose set-up
+  // fails ends the hierarchy there; SetupError when the first one does.
   MultigridPreconditioner(const Scene<D>& fine, const DofMap<D>& fineDofs,
                           TangentStiffness<D>& fineTangent,
                           std::vector<std::unique_ptr<Scene<D>>> coarse,

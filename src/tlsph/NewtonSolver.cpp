@@ -53,9 +53,15 @@ NewtonSolver<D>::NewtonSolver(Scene<D>& scene, Solver<D>& solver, const NewtonSe
             "[static] preconditioner = multigrid: the scene cannot be rebuilt at twice its "
             "particle spacing with fewer unknowns (use preconditioner = cholesky)");
     } else {
-      multigrid_ = std::make_unique<MultigridPreconditioner<D>>(scene, dofs_, tangent_,
-                                                                std::move(coarse), solverSettings);
-      statistics_.levels = multigrid_->levelCount();
+      try {
+        multigrid_ = std::make_unique<MultigridPreconditioner<D>>(
+            scene, dofs_, tangent_, std::move(coarse), solverSettings);
+        statistics_.levels = multigrid_->levelCount();
+      } catch (const SetupError& e) {
+        if (explicitly)
+          throw SetupError(std::string("[static] preconditioner = multigrid: ") + e.what() +
+                           " (use preconditioner = cholesky)");
+      }
     }
   }
   statistics_.linearSolver = multigrid_ ? multigrid_->description() : SparseCholesky::name();
