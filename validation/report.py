@@ -1238,12 +1238,17 @@ def problem_section(key, p, runs, R):
         cols = COLUMNS[key]
         rows = []
         for r in lad:
+            # a Newton run has iterations, not time steps
+            newton = r.get("solver") == "newton" and r.get("newton")
             rows.append([g(r["dx"], 4), r["per_thickness"], particles(r),
-                         f3(r.get("neighbours_mean"), 1), r.get("steps") or "-",
-                         g(r.get("dt"), 3), f3(r.get("wall_seconds"), 1), outcome(r)] +
+                         f3(r.get("neighbours_mean"), 1),
+                         newton_stats(r) if newton else (r.get("steps") or "-"),
+                         "-" if newton else g(r.get("dt"), 3), f3(r.get("wall_seconds"), 1),
+                         outcome(r)] +
                         [fn(r) for _, fn in cols])
-        L += table(["dx [m]", "per thickness", "particles (ghosts)", "mean nb", "steps",
-                    "dt [s]", "wall s", "outcome"] + [h for h, _ in cols], rows)
+        L += table(["dx [m]", "per thickness", "particles (ghosts)", "mean nb",
+                    "steps (Newton: iterations)", "dt [s]", "wall s", "outcome"] +
+                   [h for h, _ in cols], rows)
         L.append("")
         # convergence
         conv_rows = []
