@@ -18,6 +18,7 @@
 #include "scene/InputError.hpp"
 #include "scene/SceneBuilder.hpp"
 #include "tlsph/ConjugateGradients.hpp"
+#include "tlsph/Lattice.hpp"
 #include "tlsph/MlsInterpolation.hpp"
 #include "tlsph/MultigridPreconditioner.hpp"
 
@@ -37,26 +38,12 @@ std::vector<Vec<D>> randomPoints(std::mt19937& rng, int count, double size) {
 }
 
 template <int D>
-std::vector<Vec<D>> lattice(int perSide, double dx) {
-  std::vector<Vec<D>> X;
-  const int total = D == 2 ? perSide * perSide : perSide * perSide * perSide;
-  for (int k = 0; k < total; ++k) {
-    Vec<D> x;
-    int rest = k;
-    for (int a = 0; a < D; ++a) {
-      x[a] = (rest % perSide + 0.5) * dx;
-      rest /= perSide;
-    }
-    X.push_back(x);
-  }
-  return X;
-}
-
-template <int D>
 void expectLinearFieldsReproduced(std::uint32_t seed) {
   std::mt19937 rng(seed);
   const double dx = 0.1;
-  const auto sources = lattice<D>(10, dx);  // a 1 x 1 (x 1) block
+  std::array<int, D> ten;
+  ten.fill(10);
+  const auto sources = cellCentredLattice<D>(Vec<D>::Zero(), ten, dx);  // a 1 x 1 (x 1) block
   // Targets inside, away from where the support leaves the block's hull thin.
   auto targets = randomPoints<D>(rng, 200, 0.8);
   for (auto& t : targets)
@@ -87,7 +74,7 @@ TEST(MlsInterpolation, WrapsAroundPeriodicAxes) {
   // Periodic along x: a target at x = 0.01 takes sources near x = 1 as its left neighbours, so
   // a field linear in y alone and one periodic-smooth in x are carried exactly / to first order.
   const double dx = 0.1;
-  const auto sources = lattice<2>(10, dx);
+  const auto sources = cellCentredLattice<2>(Vec<2>::Zero(), {10, 10}, dx);
   PeriodicBox<2> box;
   box.periodic = {true, false};
   box.length = Vec<2>(1.0, 0.0);
@@ -364,38 +351,10 @@ TEST(Multigrid, AutoFallsBackToTheFactorWhenItsIterationStalls) {
 TEST(Multigrid, AThinBodyWithoutACoarseLevelKeepsTheFactor) {
   // Two particles through the thickness: at twice the spacing one, where the correction tensor
   // is singular. auto runs with the factor; multigrid asked for is refused, saying why.
-  const std::string thin = R"([scene]
-dimension = 3
-dx = 0.0125
-[material.plate]
-model = saint-venant-kirchhoff
-density = 1000
-youngs_modulus = 1.0e7
-poisson_ratio = 0.3
-[body.plate]
-shape = box
-lower = 0 0 0
-upper = 0.3 0.3 0.025
-[clamp.left]
-face = x-
-[clamp.right]
-face = x+
-[load.pressure]
-face = z+
-type = traction
-value = 0 0 -10
-ramp = 0.005
-[static]
-solver = newton
-[time]
-end = 1
-[output]
-fields = none
-)";
   auto setup = [&](const std::string& preconditioner) {
     SceneSetup<3> s = buildScene<3>(Config::parse(
-        thin, "thin.ini",
-        {"--static.preconditioner=" + preconditioner,
+        plate(0.0125), "thin.ini",
+        {"--body.plate.upper=0.3 0.3 0.025", "--static.preconditioner=" + preconditioner,
          "--output.directory=" + (fs::temp_directory_path() / "tlsph_multigrid_thin").string()}));
     s.run.newton.autoMultigridUnknowns = 100;
     return s;

@@ -8,28 +8,11 @@
 #include <set>
 
 #include "tlsph/DomainPartition.hpp"
+#include "tlsph/Lattice.hpp"
 
 using namespace tlsph;
 
 namespace {
-
-template <int D>
-std::vector<Vec<D>> lattice(const std::array<int, D>& counts, double dx) {
-  std::vector<Vec<D>> X;
-  int total = 1;
-  for (int c : counts)
-    total *= c;
-  for (int k = 0; k < total; ++k) {
-    Vec<D> x;
-    int rest = k;
-    for (int a = 0; a < D; ++a) {
-      x[a] = (rest % counts[a] + 0.5) * dx;
-      rest /= counts[a];
-    }
-    X.push_back(x);
-  }
-  return X;
-}
 
 void expectConsistent(const DomainPartition& p, const NeighbourList& nb) {
   const Index n = nb.particleCount();
@@ -57,7 +40,7 @@ TEST(DomainPartition, BisectionCutsABeamAcrossItsLength) {
   // 80 x 8 x 8 particles, support 2.1 dx: two parts meet at mid-length, and each reads the
   // other's two nearest layers of 64 particles.
   const double dx = 0.01;
-  const auto X = lattice<3>({80, 8, 8}, dx);
+  const auto X = cellCentredLattice<3>(Vec<3>::Zero(), {80, 8, 8}, dx);
   const NeighbourList nb = buildNeighbourList<3>(X, 2.1 * dx);
   const DomainPartition p = partitionByBisection<3>(X, nb, 2);
   expectConsistent(p, nb);
@@ -71,8 +54,8 @@ TEST(DomainPartition, BisectionCutsABeamAcrossItsLength) {
 
 TEST(DomainPartition, PartsAreBalancedAndHalosExact) {
   const double dx = 0.01;
-  const auto plate = lattice<3>({40, 40, 4}, dx);
-  const auto square = lattice<2>({60, 45}, dx);
+  const auto plate = cellCentredLattice<3>(Vec<3>::Zero(), {40, 40, 4}, dx);
+  const auto square = cellCentredLattice<2>(Vec<2>::Zero(), {60, 45}, dx);
   const NeighbourList nb3 = buildNeighbourList<3>(plate, 2.1 * dx);
   const NeighbourList nb2 = buildNeighbourList<2>(square, 2.1 * dx);
   for (int parts : {2, 3, 4, 7}) {
@@ -98,7 +81,7 @@ TEST(DomainPartition, PartsAreBalancedAndHalosExact) {
 
 TEST(DomainPartition, KeepsTheSmallerHaloAndIsReproducible) {
   const double dx = 0.01;
-  const auto X = lattice<3>({30, 20, 6}, dx);
+  const auto X = cellCentredLattice<3>(Vec<3>::Zero(), {30, 20, 6}, dx);
   const NeighbourList nb = buildNeighbourList<3>(X, 2.1 * dx);
   for (int parts : {1, 2, 4}) {
     const DomainPartition chosen = partitionParticles<3>(X, nb, parts);

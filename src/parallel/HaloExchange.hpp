@@ -28,10 +28,7 @@ class HaloExchange {
   HaloExchange(const HaloExchange&) = delete;
   HaloExchange& operator=(const HaloExchange&) = delete;
 
-  int rank() const { return rank_; }
-  const std::vector<int>& neighbours() const { return neighbours_; }
   std::size_t haloCount() const { return receiveIndex_.size(); }
-  std::size_t sendCount() const { return sendIndex_.size(); }
 
   // T: plain data (numbers; fixed-size Eigen vectors and matrices, arrays of doubles).
   template <class T>

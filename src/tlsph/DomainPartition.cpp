@@ -28,13 +28,6 @@ Index DomainPartition::haloTotal() const {
   return total;
 }
 
-Index DomainPartition::haloLargest() const {
-  Index largest = 0;
-  for (const auto& h : halo)
-    largest = std::max(largest, static_cast<Index>(h.size()));
-  return largest;
-}
-
 double DomainPartition::imbalance(const NeighbourList& nb) const {
   std::vector<double> load(parts, 0.0);
   double total = 0.0;

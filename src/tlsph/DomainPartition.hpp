@@ -27,7 +27,6 @@ struct DomainPartition {
   std::vector<std::vector<Index>> halo;   // per part: other parts' particles its own read
 
   Index haloTotal() const;
-  Index haloLargest() const;
   // Largest part's weight (pairs + particles) over the mean: 1 is perfect balance.
   double imbalance(const NeighbourList& nb) const;
 };

@@ -255,14 +255,6 @@ std::vector<Index> MultigridPreconditioner<D>::unknowns() const {
 }
 
 template <int D>
-std::vector<double> MultigridPreconditioner<D>::spectrumBounds() const {
-  std::vector<double> b;
-  for (std::size_t l = 0; l + 1 < levels_.size(); ++l)
-    b.push_back(levels_[l]->lambdaMax);
-  return b;
-}
-
-template <int D>
 std::string MultigridPreconditioner<D>::description() const {
   std::ostringstream s;
   s << levels_.size() << "-level multigrid (";

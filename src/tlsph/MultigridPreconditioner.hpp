@@ -58,8 +58,6 @@ class MultigridPreconditioner {
   std::vector<Index> unknowns() const;
   long coarsestNonZeros() const { return coarsestNonZeros_; }
   long coarsestFactorNonZeros() const { return factor_.factorNonZeros(); }
-  // Largest eigenvalue estimate of D^-1 K per level but the coarsest (after update()).
-  std::vector<double> spectrumBounds() const;
   std::string description() const;
 
  private:

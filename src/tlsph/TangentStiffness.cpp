@@ -2,11 +2,24 @@
 // Compiled once for 2D and 3D.
 #include "tlsph/TangentStiffness.hpp"
 
+#include <utility>
+
 #ifdef _OPENMP
 #include <omp.h>
 #endif
 
 namespace tlsph {
+
+namespace {
+// This thread's number and the team's size (0 of 1 without OpenMP).
+std::pair<int, int> threadSlot() {
+#ifdef _OPENMP
+  return {omp_get_thread_num(), omp_get_num_threads()};
+#else
+  return {0, 1};
+#endif
+}
+}  // namespace
 
 template <int D>
 void TangentStiffness<D>::update(const std::vector<Mat<D>>& F) {
@@ -91,11 +104,7 @@ const typename TangentStiffness<D>::SparseMatrix& TangentStiffness<D>::assemble(
   const Index nd = dofs_.size();
 #pragma omp parallel
   {
-    int thread = 0, threads = 1;
-#ifdef _OPENMP
-    thread = omp_get_thread_num();
-    threads = omp_get_num_threads();
-#endif
+    const auto [thread, threads] = threadSlot();
     // Block columns [first, last): an equal share of the stored blocks.
     auto columnAt = [&](int t) {
       const Index target = blockStart_[nd] * t / threads;
@@ -123,16 +132,7 @@ const typename TangentStiffness<D>::SparseMatrix& TangentStiffness<D>::assemble(
       const bool penalty = penalty_ != nullptr;
       const Index count = nb.offset[i + 1] - nb.offset[i];
       if (penalty) {
-        // C(p, J) = coefficient of u_p in r_IJ = u_I - u_J - H_I X_IJ (reduced).
-        C.setZero(m, count);
-        for (Index p = 0; p < m; ++p)
-          for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k)
-            C(p, k - nb.offset[i]) = s.self[p] - s.bh[p].dot(ref_.separation[k]);
-        for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
-          auto [t, end] = dofs_.terms(nb.neighbour[k]);
-          for (; t != end; ++t)
-            C(s.position(t->dof), k - nb.offset[i]) -= t->weight;
-        }
+        penaltyCoefficients(i, s, C);
         CK = C;
         for (Index k = 0; k < count; ++k)
           CK.col(k) *= 0.5 * volume_[i] * c_[nb.offset[i] + k];  // 1/2 k_IJ
@@ -176,16 +176,14 @@ std::vector<Mat<D>> TangentStiffness<D>::diagonalBlocks() const {
   // As in assemble(): each thread owns a range of unknowns and takes the particles in order.
 #pragma omp parallel
   {
-    int thread = 0, threads = 1;
-#ifdef _OPENMP
-    thread = omp_get_thread_num();
-    threads = omp_get_num_threads();
-#endif
+    const auto [thread, threads] = threadSlot();
     const Index first = nd * thread / threads, last = nd * (thread + 1) / threads;
     Stencil s;
+    Eigen::MatrixXd C;
     for (Index i = 0; i < n_; ++i) {
       if (hi[i] < first || lo[i] >= last) continue;
       reducedStencil(i, s);
+      if (penalty_) penaltyCoefficients(i, s, C);
       const Index m = static_cast<Index>(s.dof.size());
       for (Index p = s.position(first); p < m && s.dof[p] < last; ++p) {
         Mat<D> block = Mat<D>::Zero();
@@ -196,15 +194,10 @@ std::vector<Mat<D>> TangentStiffness<D>::diagonalBlocks() const {
           block *= volume_[i];
         }
         if (penalty_) {
-          // 1/2 V_I sum_J k_IJ C(p, J)^2, C as in assemble()
+          // 1/2 V_I sum_J k_IJ C(p, J)^2, as in assemble()
           double sum = 0.0;
-          for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
-            double c = s.self[p] - s.bh[p].dot(ref_.separation[k]);
-            auto [t, end] = dofs_.terms(nb.neighbour[k]);
-            for (; t != end; ++t)
-              if (t->dof == s.dof[p]) c -= t->weight;
-            sum += c_[k] * c * c;
-          }
+          for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k)
+            sum += c_[k] * C(p, k - nb.offset[i]) * C(p, k - nb.offset[i]);
           block.diagonal().array() += 0.5 * volume_[i] * sum;
         }
         diagonal[s.dof[p]] += block;
@@ -212,6 +205,22 @@ std::vector<Mat<D>> TangentStiffness<D>::diagonalBlocks() const {
     }
   }
   return diagonal;
+}
+
+// C(p, J) = coefficient of u_p in r_IJ = u_I - u_J - H_I X_IJ (reduced to I's stencil).
+template <int D>
+void TangentStiffness<D>::penaltyCoefficients(Index i, const Stencil& s, Eigen::MatrixXd& C) const {
+  const auto& nb = ref_.neighbours;
+  const Index m = static_cast<Index>(s.dof.size());
+  C.setZero(m, nb.count(i));
+  for (Index p = 0; p < m; ++p)
+    for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k)
+      C(p, k - nb.offset[i]) = s.self[p] - s.bh[p].dot(ref_.separation[k]);
+  for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
+    auto [t, end] = dofs_.terms(nb.neighbour[k]);
+    for (; t != end; ++t)
+      C(s.position(t->dof), k - nb.offset[i]) -= t->weight;
+  }
 }
 
 template <int D>

@@ -154,6 +154,8 @@ class TangentStiffness {
   };
 
   void reducedStencil(Index i, Stencil& s) const;
+  // The penalty's residual coefficients C(p, J) of I's stencil (assemble(), diagonalBlocks()).
+  void penaltyCoefficients(Index i, const Stencil& s, Eigen::MatrixXd& C) const;
 
   // B = b (x) 1_D: vec(u b^T) = B u.
   using Kronecker = Eigen::Matrix<double, DD, D>;

@@ -9,28 +9,11 @@
 #include <limits>
 
 #include "parallel/HaloExchange.hpp"
+#include "tlsph/Lattice.hpp"
 
 using namespace tlsph;
 
 namespace {
-
-template <int D>
-std::vector<Vec<D>> lattice(const std::array<int, D>& counts, double dx) {
-  std::vector<Vec<D>> X;
-  int total = 1;
-  for (int c : counts)
-    total *= c;
-  for (int k = 0; k < total; ++k) {
-    Vec<D> x;
-    int rest = k;
-    for (int a = 0; a < D; ++a) {
-      x[a] = (rest % counts[a] + 0.5) * dx;
-      rest /= counts[a];
-    }
-    X.push_back(x);
-  }
-  return X;
-}
 
 double valueOf(Index i) {
   return 1.0 + 0.5 * i;
@@ -42,7 +25,7 @@ int check(const std::array<int, D>& counts, const char* name) {
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   MPI_Comm_size(MPI_COMM_WORLD, &size);
   const double dx = 0.01;
-  const auto X = lattice<D>(counts, dx);
+  const auto X = cellCentredLattice<D>(Vec<D>::Zero(), counts, dx);
   const NeighbourList nb = buildNeighbourList<D>(X, 2.1 * dx);
   const DomainPartition partition = partitionParticles<D>(X, nb, size);
   HaloExchange halo(MPI_COMM_WORLD, partition);
