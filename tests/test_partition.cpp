@@ -4,6 +4,7 @@
 // kept.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <iostream>
 #include <set>
 
@@ -95,6 +96,33 @@ TEST(DomainPartition, KeepsTheSmallerHaloAndIsReproducible) {
       EXPECT_EQ(chosen.haloTotal(), 0);
     }
   }
+}
+
+TEST(DomainPartition, KeepTogetherPutsEveryChainOfLinksInOnePart) {
+  // A 2D strip cut in two across its length; links that straddle the cut (as a clamp's ghost and
+  // the particles it follows may) and a chain through three particles.
+  const double dx = 0.01;
+  const auto X = cellCentredLattice<2>(Vec<2>::Zero(), {40, 6}, dx);
+  const NeighbourList nb = buildNeighbourList<2>(X, 2.1 * dx);
+  DomainPartition p = partitionByBisection<2>(X, nb, 2);
+  auto at = [&](int column, int row) {
+    const Vec<2> point((column + 0.5) * dx, (row + 0.5) * dx);
+    for (Index i = 0; i < static_cast<Index>(X.size()); ++i)
+      if ((X[i] - point).norm() < 1e-9) return i;
+    return Index(-1);
+  };
+  const Index a = at(19, 2), b = at(20, 2), c = at(25, 4), first = at(0, 0), last = at(39, 5);
+  ASSERT_NE(p.part[a], p.part[b]);
+  const std::vector<std::pair<Index, Index>> links = {{c, b}, {b, a}};
+  const int chainPart = p.part[std::min({a, b, c})];  // the chain's lowest index decides
+  const int firstPart = p.part[first], lastPart = p.part[last];
+  keepTogether(p, links, nb);
+  expectConsistent(p, nb);
+  EXPECT_EQ(p.part[a], chainPart);
+  EXPECT_EQ(p.part[b], chainPart);
+  EXPECT_EQ(p.part[c], chainPart);
+  EXPECT_EQ(p.part[first], firstPart);  // the others stay where they were
+  EXPECT_EQ(p.part[last], lastPart);
 }
 
 }  // namespace

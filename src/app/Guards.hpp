@@ -127,6 +127,7 @@ class RunGuard {
 
   // Takes the present state (before the first step) as the first good one.
   RunGuard(SceneSetup<D>& setup, Solver<D>& solver) : setup_(setup), solver_(solver) {
+    solver.synchronize();
     const auto& p = setup.scene.particles;
     initial_ = solver.energyBalance();
     total0_ = initial_.total();
@@ -158,6 +159,7 @@ class RunGuard {
   // instability found, with its likely cause.
   std::optional<Instability> check() {
     using namespace guard_detail;
+    solver_.synchronize();
     const auto& p = setup_.scene.particles;
     const auto& F = solver_.forces().deformationGradient();
     const StateScan s = scanState(p, F, setup_.ghost);
@@ -232,20 +234,28 @@ class RunGuard {
   // Writes NAME_failed.vtu (the present state) and NAME_last_good.vtu (the last good state,
   // put back into the particles with the forces re-evaluated: the solver is left there) into
   // the output directory, with every output field, whatever [output] fields says.
+  // Distributed: every rank re-evaluates, rank 0 writes.
   void writeFrames(Instability& found) {
     namespace fs = std::filesystem;
     const fs::path dir = setup_.output.directory;
-    fs::create_directories(dir);
+    const Communicator* comm = solver_.communicator();
+    const bool root = !comm || comm->rank() == 0;
     found.failedFrame = dir / (setup_.name + "_failed.vtu");
-    writeVtuFile(makeFrame(setup_, solver_, allFrameFields()), found.failedFrame);
+    found.lastGoodFrame = dir / (setup_.name + "_last_good.vtu");
+    solver_.synchronize();
+    if (root) {
+      fs::create_directories(dir);
+      writeVtuFile(makeFrame(setup_, solver_, allFrameFields()), found.failedFrame);
+    }
     auto& p = setup_.scene.particles;
     p.displacement = last_.displacement;
     p.velocity = last_.velocity;
     solver_.reevaluate();
+    solver_.synchronize();
+    if (!root) return;
     Frame good = makeFrame(setup_, solver_, allFrameFields());
     good.time = last_.time;
     good.step = last_.step;
-    found.lastGoodFrame = dir / (setup_.name + "_last_good.vtu");
     writeVtuFile(good, found.lastGoodFrame);
   }
 

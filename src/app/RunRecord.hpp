@@ -99,7 +99,12 @@ void writeRunRecord(const std::filesystem::path& file, const SceneSetup<D>& setu
   field("steps", std::to_string(s.steps));
   field("simulated_time", jsonNumber(s.time));
   field("wall_seconds", jsonNumber(s.wallSeconds));
+  // threads: OpenMP threads per rank; ranks: MPI processes (1 for a serial run).
   field("threads", std::to_string(threads));
+  field("ranks", std::to_string(s.partition.ranks));
+  field("partition_method", jsonText(s.partition.method));
+  field("halo_particles", std::to_string(s.partition.halo));
+  field("partition_imbalance", jsonNumber(s.partition.imbalance));
   field("particle_steps_per_second",
         jsonNumber(s.wallSeconds > 0 ? double(n) * s.steps / s.wallSeconds : 0.0));
   field("outcome", jsonText(outcomeName(s.outcome)));

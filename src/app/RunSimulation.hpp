@@ -30,6 +30,9 @@ struct RunOptions {
   bool progress = false;    // a live progress line (on a terminal only)
   std::string command;      // recorded in the CSV preamble, to reproduce the run
   CheckpointOrigin origin;  // recorded in each checkpoint: the scene and the program
+  // A distributed run (null: serial). Every rank runs the loop below on the same gathered
+  // state and takes the same decisions; rank 0 alone writes files.
+  Communicator* comm = nullptr;
 };
 
 // OutputFailed: a file could not be written (disk full, no permission): the run stops.
@@ -52,7 +55,8 @@ struct RunSummary {
   std::optional<NewtonStatistics> newton;  // set for a Newton static run
   std::filesystem::path checkpoint;        // the last checkpoint this run wrote
   long checkpointsWritten = 0;
-  long restartedAtStep = -1;  // the checkpoint's step when the run was restarted
+  long restartedAtStep = -1;   // the checkpoint's step when the run was restarted
+  PartitionSummary partition;  // ranks, and how the particles were split among them
 };
 
 template <int D>
@@ -126,7 +130,13 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
   namespace fs = std::filesystem;
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
-  Solver<D> solver(setup.scene, setup.solver);
+  Communicator* comm = options.comm;
+  const bool root = !comm || comm->rank() == 0;
+  if (comm && setup.run.newtonStatic())
+    throw SetupError(
+        "the Newton solver ([static] solver = newton) runs on one rank only: start "
+        "it without mpirun (or with -np 1), or use solver = damped");
+  Solver<D> solver(setup.scene, setup.solver, comm);
   onStart(solver);
   if (resume) solver.restore(resume->solver);
   const auto& p = setup.scene.particles;
@@ -134,8 +144,8 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
   const OutputSettings& out = setup.output;
   const fs::path dir = out.directory;
 
-  std::unique_ptr<VtuSeriesWriter> vtu;
-  if (!out.fields.empty()) vtu = std::make_unique<VtuSeriesWriter>(dir, setup.name);
+  std::unique_ptr<VtuSeriesWriter> vtu;  // rank 0's
+  if (!out.fields.empty() && root) vtu = std::make_unique<VtuSeriesWriter>(dir, setup.name);
   const std::vector<std::string> preamble = {
       "tlsph scene " + setup.name + " from " + setup.sourceFile, "command: " + options.command,
       "SI units: s, m, J, kg m/s"};
@@ -172,6 +182,7 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
   };
 
   auto recordSeries = [&] {
+    solver.synchronize();
     const EnergyBalance e = solver.energyBalance();
     Vec3 momentum = Vec3::Zero();
     momentum.head<D>() = linearMomentum(p);
@@ -192,15 +203,20 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
     if (probes) probes->append(probeRow(setup, solver));
     if (reactions) reactions->append(reactionRow());
   };
-  // Every write goes through here: a failure stops the run as OutputFailed.
+  // Every write goes through here: a failure stops the run as OutputFailed. Rank 0 writes and
+  // tells the others how it went.
   auto writing = [&](auto&& write) {
-    try {
-      write();
-    } catch (const OutputWriteFailure&) {
-      throw;
-    } catch (const std::exception& e) {
-      throw OutputWriteFailure(e.what());
+    std::string failure;
+    if (root) {
+      try {
+        write();
+      } catch (const std::exception& e) {
+        failure = e.what();
+        if (failure.empty()) failure = "unknown error";
+      }
     }
+    if (comm) comm->broadcast(failure);
+    if (!failure.empty()) throw OutputWriteFailure(failure);
   };
   auto flushSeries = [&] {
     writing([&] {
@@ -212,7 +228,8 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
   long lastFrameStep = -1;
   double nextFrameTime = out.everyTime;
   auto writeFrame = [&] {
-    if (vtu && lastFrameStep != solver.stepCount())
+    solver.synchronize();
+    if (!out.fields.empty() && lastFrameStep != solver.stepCount())
       writing([&] { vtu->write(makeFrame(setup, solver)); });
     lastFrameStep = solver.stepCount();
     flushSeries();
@@ -239,6 +256,7 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
   CheckpointSchedule schedule(dir, setup.name, setup.checkpoint);
   // The series are flushed first, so that the files hold every row the checkpoint counts.
   auto saveCheckpoint = [&](const NewtonSolver<D>* newton) {
+    solver.synchronize();
     flushSeries();
     Checkpoint<D> c;
     c.origin = options.origin;
@@ -252,8 +270,10 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
     c.output.reactionRows = reactions ? reactions->rowCount() : 0;
     if (vtu) c.output.frames = vtu->frames();
     const fs::path file = schedule.fileFor(solver.stepCount());
-    writing([&] { writeCheckpoint(file, c); });
-    schedule.written();
+    writing([&] {
+      writeCheckpoint(file, c);
+      schedule.written();
+    });
     summary.checkpoint = file;
     ++summary.checkpointsWritten;
   };
@@ -280,6 +300,8 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
   // What every run reports at its end.
   bool stateRecorded = false;  // an unstable run reports the failing state, recorded before
   auto finish = [&] {
+    solver.synchronize();
+    summary.partition = solver.partition();
     summary.wallSeconds = std::chrono::duration<double>(Clock::now() - start).count();
     if (vtu) summary.pvd = vtu->pvdPath();
     summary.energies = dir / "energies.csv";
@@ -364,6 +386,21 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
   auto lastFlush = Clock::now();
   const auto flushInterval = std::chrono::duration<double>(out.flushSeconds);
   const double endTime = run.endTime * (1.0 - 1e-12);
+  // What depends on a signal or a wall clock is rank 0's view, shared every step, so that all
+  // ranks stop, write and check at the same step: 0 stop requested, 1 progress line due,
+  // 2 series flush due, 3 checkpoint due (its wall-time interval; the step interval is common).
+  auto agreed = [&](long step) {
+    std::array<double, 4> due = {
+        stopRequested() ? 1.0 : 0.0,
+        options.progress && Clock::now() - lastProgress > std::chrono::milliseconds(500) ? 1.0
+                                                                                         : 0.0,
+        Clock::now() - lastFlush > flushInterval ? 1.0 : 0.0, schedule.due(step) ? 1.0 : 0.0};
+    if (comm) {
+      if (!root) due = {due[0], 0.0, 0.0, 0.0};
+      comm->max(due.data(), 4);
+    }
+    return std::array<bool, 4>{due[0] > 0, due[1] > 0, due[2] > 0, due[3] > 0};
+  };
   try {
     if (!resume) {
       recordSeries();
@@ -380,7 +417,8 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
             "stopped at the step limit [time] max_steps = " + std::to_string(run.maxSteps);
         break;
       }
-      if (stopRequested()) {
+      const std::array<bool, 4> due = agreed(solver.stepCount() + 1);
+      if (due[0]) {
         // A checkpoint of a healthy state only: the guards look at it first.
         summary.instability = guard.check();
         if (summary.instability) {
@@ -409,7 +447,7 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
       }
       if (step % out.seriesEverySteps == 0) {
         recordSeries();
-        if (Clock::now() - lastFlush > flushInterval) {
+        if (due[2]) {
           flushSeries();
           lastFlush = Clock::now();
         }
@@ -422,15 +460,16 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
           nextFrameTime += out.everyTime;
       }
       // A checkpoint holds a state the guards have passed: a good one to continue from.
-      if (schedule.due(step)) {
+      if (due[3]) {
         if (!checkStep && (summary.instability = guard.check())) {
           summary.outcome = RunOutcome::Unstable;
           break;
         }
         saveCheckpoint(nullptr);
       }
-      if (options.progress && Clock::now() - lastProgress > std::chrono::milliseconds(500)) {
+      if (due[1]) {
         lastProgress = Clock::now();
+        solver.synchronize();
         const double wall = std::chrono::duration<double>(lastProgress - start).count();
         const EnergyBalance e = solver.energyBalance();
         std::fprintf(stderr, "\r\033[Kstep %ld  t = %.4g s of %.4g  dt = %.3g  ", step,
@@ -451,6 +490,7 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
     } else {
       // The failing state's numbers for the record, then its frames (which leave the solver
       // in the last good state).
+      solver.synchronize();
       flushSeries();
       summary.steps = solver.stepCount();
       summary.time = solver.time();

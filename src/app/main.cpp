@@ -27,6 +27,11 @@
 #ifdef _OPENMP
 #include <omp.h>
 #endif
+#ifdef TLSPH_HAVE_MPI
+#include <mpi.h>
+
+#include "parallel/MpiCommunicator.hpp"
+#endif
 
 namespace {
 
@@ -235,9 +240,27 @@ CheckpointOrigin runOrigin(const Config& config, const RunFlags& flags, int thre
   return origin;
 }
 
+// Runs `action` on rank 0 only; an exception there is thrown on every rank (with its message),
+// so that no rank goes on alone into the run's collectives.
+template <class Action>
+void onRoot(Communicator* comm, Action&& action) {
+  if (!comm) return action();
+  std::string failure;
+  if (comm->rank() == 0) {
+    try {
+      action();
+    } catch (const std::exception& e) {
+      failure = e.what();
+      if (failure.empty()) failure = "unknown error";
+    }
+  }
+  comm->broadcast(failure);
+  if (!failure.empty()) throw std::runtime_error(failure);
+}
+
 template <int D>
 int runOrCheck(const Config& config, bool run, bool progress, const std::string& command,
-               const RunFlags& flags) {
+               const RunFlags& flags, Communicator* comm) {
   SceneSetup<D> setup = buildScene<D>(config);
   for (const auto& warning : setup.warnings)
     std::cerr << command << ": warning: " << warning << "\n";
@@ -253,6 +276,7 @@ int runOrCheck(const Config& config, bool run, bool progress, const std::string&
   options.progress = progress;
   options.command = command;
   options.origin = runOrigin(config, flags, threads);
+  options.comm = comm;
 
   std::optional<Checkpoint<D>> resume;
   if (!flags.restart.empty()) {
@@ -268,7 +292,9 @@ int runOrCheck(const Config& config, bool run, bool progress, const std::string&
     std::cout << "restart      from " << file.string() << " (step " << resume->solver.steps
               << ", t = " << resume->solver.time << " s)\n";
   }
-  prepareOutputDirectory(setup.output.directory, setup.name, flags.overwrite, resume.has_value());
+  onRoot(comm, [&] {
+    prepareOutputDirectory(setup.output.directory, setup.name, flags.overwrite, resume.has_value());
+  });
 
   installStopHandlers();
   NeighbourStats neighbours;
@@ -278,14 +304,17 @@ int runOrCheck(const Config& config, bool run, bool progress, const std::string&
         addSolverWarnings(setup, solver, command);
         printSetup(setup, solver);
         if (!resume)
-          checkFreeSpace(setup.output.directory, estimateOutput(setup, solver.timeStep()));
+          onRoot(comm, [&] {
+            checkFreeSpace(setup.output.directory, estimateOutput(setup, solver.timeStep()));
+          });
         neighbours = neighbourStats(solver, setup.scene.particles.size());
       },
       resume ? &*resume : nullptr);
   const std::filesystem::path record =
       std::filesystem::path(setup.output.directory) / "summary.json";
   try {
-    writeRunRecord(record, setup, neighbours, s, threads, command, kVersion);
+    if (!comm || comm->rank() == 0)
+      writeRunRecord(record, setup, neighbours, s, threads, command, kVersion);
   } catch (const std::exception& e) {
     std::cerr << "tlsph: cannot write " << record.string() << ": " << e.what() << "\n";
     if (s.outcome != RunOutcome::OutputFailed) return 6;
@@ -309,8 +338,13 @@ int runOrCheck(const Config& config, bool run, bool progress, const std::string&
   } else {
     std::cout << "\nsteps " << s.steps << ", simulated " << s.time << " s, wall " << s.wallSeconds
               << " s (" << double(setup.scene.particles.size()) * s.steps / s.wallSeconds
-              << " particle-steps/s, " << threads << (threads == 1 ? " thread" : " threads")
-              << ")\n";
+              << " particle-steps/s, ";
+    if (s.partition.ranks > 1)
+      std::cout << s.partition.ranks << " ranks x " << threads
+                << (threads == 1 ? " thread" : " threads") << "; partition " << s.partition.method
+                << ", " << s.partition.halo << " halo particles)\n";
+    else
+      std::cout << threads << (threads == 1 ? " thread" : " threads") << ")\n";
   }
   std::cout << "energy       kinetic " << s.energy.kinetic << ", strain " << s.energy.strain
             << ", hourglass " << s.energy.hourglass << ", external work " << s.energy.externalWork
@@ -369,7 +403,45 @@ int runOrCheck(const Config& config, bool run, bool progress, const std::string&
 
 }  // namespace
 
+#ifdef TLSPH_HAVE_MPI
+// MPI for a process started by mpirun; finalised on the way out, whatever the path.
+struct MpiSession {
+  std::unique_ptr<MpiCommunicator> comm;  // null unless more than one rank
+  bool initialised = false;
+  MpiSession(int& argc, char**& argv) {
+    if (!launchedByMpi()) return;
+    int provided = 0;
+    MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
+    initialised = true;
+    int size = 1;
+    MPI_Comm_size(MPI_COMM_WORLD, &size);
+    if (size > 1) comm = std::make_unique<MpiCommunicator>(MPI_COMM_WORLD);
+  }
+  ~MpiSession() {
+    comm.reset();  // frees its communicators before MPI goes
+    if (initialised) MPI_Finalize();
+  }
+};
+#endif
+
+int tlsphMain(int argc, char** argv, Communicator* comm);
+
 int main(int argc, char** argv) {
+#ifdef TLSPH_HAVE_MPI
+  MpiSession mpi(argc, argv);
+  Communicator* comm = mpi.comm.get();
+  // Rank 0 speaks for the run: the others run silently (their messages would repeat its own).
+  if (comm && comm->rank() != 0) {
+    std::cout.setstate(std::ios::failbit);
+    std::cerr.setstate(std::ios::failbit);
+  }
+  return tlsphMain(argc, argv, comm);
+#else
+  return tlsphMain(argc, argv, nullptr);
+#endif
+}
+
+int tlsphMain(int argc, char** argv, Communicator* comm) {
   std::vector<std::string> args(argv + 1, argv + argc);
   if (args.empty() || args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
     std::cout << kUsage;
@@ -387,7 +459,7 @@ int main(int argc, char** argv) {
     return 1;
   }
   const char* ci = std::getenv("CI");
-  bool progress = isatty(STDERR_FILENO) && !(ci && *ci);
+  bool progress = isatty(STDERR_FILENO) && !(ci && *ci) && (!comm || comm->rank() == 0);
   std::vector<std::string> overrides;
   std::string command = "tlsph";
   for (const auto& a : args)
@@ -440,10 +512,13 @@ int main(int argc, char** argv) {
     }
   }
   flags.overrides = overrides;
+  if (comm && comm->rank() != 0) progress = false;
   try {
     const Config config = Config::read(args[1], overrides);
     const int d = sceneDimension(config);
     if (verb == "modes") {
+      if (comm)
+        throw std::runtime_error("tlsph modes runs on one rank only: start it without mpirun");
       modes.run.command = command;
       modes.run.progress = progress;
       modes.run.origin = runOrigin(config, flags, ompThreads());
@@ -454,8 +529,8 @@ int main(int argc, char** argv) {
       SceneSetup<3> setup = buildScene<3>(config);
       return runModes<3>(setup, modes);
     }
-    return d == 2 ? runOrCheck<2>(config, verb == "run", progress, command, flags)
-                  : runOrCheck<3>(config, verb == "run", progress, command, flags);
+    return d == 2 ? runOrCheck<2>(config, verb == "run", progress, command, flags, comm)
+                  : runOrCheck<3>(config, verb == "run", progress, command, flags, comm);
   } catch (const InputError& e) {
     std::cerr << "tlsph: " << e.what() << "\n";
   } catch (const SetupError& e) {

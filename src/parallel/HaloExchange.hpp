@@ -36,10 +36,10 @@ class HaloExchange {
     static_assert(std::is_trivially_destructible_v<T>);
     exchangeBytes(reinterpret_cast<char*>(values.data()), sizeof(T));
   }
-
- private:
+  // values: an array of particles of `size` bytes each.
   void exchangeBytes(char* values, std::size_t size);
 
+ private:
   MPI_Comm graph_ = MPI_COMM_NULL;
   int rank_ = 0;
   std::vector<int> neighbours_;

@@ -55,6 +55,25 @@ void completePartition(DomainPartition& p, const NeighbourList& nb) {
   }
 }
 
+void keepTogether(DomainPartition& p, const std::vector<std::pair<Index, Index>>& links,
+                  const NeighbourList& nb) {
+  if (links.empty()) return;
+  std::vector<Index> root(p.part.size());
+  std::iota(root.begin(), root.end(), 0);
+  auto find = [&](Index i) {
+    while (root[i] != i)
+      i = root[i] = root[root[i]];
+    return i;
+  };
+  for (const auto& [a, b] : links) {
+    const Index ra = find(a), rb = find(b);
+    if (ra != rb) root[std::max(ra, rb)] = std::min(ra, rb);  // the root is the lowest index
+  }
+  for (Index i = 0; i < static_cast<Index>(p.part.size()); ++i)
+    p.part[i] = p.part[find(i)];
+  completePartition(p, nb);
+}
+
 template <int D>
 DomainPartition partitionByBisection(const std::vector<Vec<D>>& X, const NeighbourList& nb,
                                      int parts) {

@@ -34,6 +34,13 @@ struct DomainPartition {
 // Owned lists and halos from `part` (and `parts`).
 void completePartition(DomainPartition& p, const NeighbourList& nb);
 
+// Puts the two particles of each link, and so every chain of links, in one part (the part of
+// the chain's lowest-index particle), then completes the partition again. Mirrored ghosts are
+// linked to the particles they follow: a ghost's motion and the chain rule of its force then
+// stay on one rank.
+void keepTogether(DomainPartition& p, const std::vector<std::pair<Index, Index>>& links,
+                  const NeighbourList& nb);
+
 template <int D>
 DomainPartition partitionByBisection(const std::vector<Vec<D>>& X, const NeighbourList& nb,
                                      int parts);

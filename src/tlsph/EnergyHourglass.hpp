@@ -42,13 +42,17 @@ class EnergyHourglass {
   // once per particle through the constant moments sum_J c_IJ X_IJ and sum_J c_IJ X_IJ X_IJ^T.
   // With Gradient = true, F holds the displacement gradients H = F - 1 themselves (the
   // tangent's linearised pass, where 1 + dH would round dH off).
+  // `particles`: only these (a distributed run's own), else all.
   template <bool Gradient = false>
   void evaluate(const std::vector<Vec<D>>& u, const std::vector<Mat<D>>& F,
-                const std::vector<Mat<D>>* P, std::vector<Mat<D>>& stress) {
+                const std::vector<Mat<D>>* P, std::vector<Mat<D>>& stress,
+                const std::vector<Index>* particles = nullptr) {
     const auto& nb = ref_.neighbours;
-    const Index n = ref_.particleCount();
+    const Index count = particles ? static_cast<Index>(particles->size()) : ref_.particleCount();
+    const Index* list = particles ? particles->data() : nullptr;
 #pragma omp parallel for schedule(static)
-    for (Index i = 0; i < n; ++i) {
+    for (Index p = 0; p < count; ++p) {
+      const Index i = list ? list[p] : p;
       const Vec<D> ui = u[i];
       Vec<D> sum = Vec<D>::Zero();
       Mat<D> moment = Mat<D>::Zero();

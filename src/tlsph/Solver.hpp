@@ -2,14 +2,19 @@
 // conditions, loads and damping, and keeping the energy books.
 #pragma once
 
+#include <array>
 #include <cmath>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "tlsph/Communicator.hpp"
 #include "tlsph/Diagnostics.hpp"
+#include "tlsph/DomainPartition.hpp"
 #include "tlsph/Errors.hpp"
 #include "tlsph/OrderedSum.hpp"
 #include "tlsph/ReferenceConfiguration.hpp"
+#include "tlsph/ReproducibleSum.hpp"
 #include "tlsph/Scene.hpp"
 #include "tlsph/TimeStep.hpp"
 #include "tlsph/TlsphForces.hpp"
@@ -54,11 +59,23 @@ struct SolverState {
   std::vector<Vec<D>> forceVelocity;
 };
 
+// How the particles of a distributed run are split (Solver::partition()).
+struct PartitionSummary {
+  int ranks = 1;
+  std::string method = "single";  // "metis", "bisection" or "single"
+  Index halo = 0;                 // particles read from other ranks, summed over the ranks
+  double imbalance = 1.0;         // largest rank's pairs + particles over the mean
+};
+
 template <int D>
 class Solver {
  public:
-  // The scene's particle arrays must not be resized while the solver lives.
-  explicit Solver(Scene<D>& scene, const SolverSettings& settings = {})
+  // The scene's particle arrays must not be resized while the solver lives. With a
+  // communicator of more than one rank the run is distributed (issue 11): the particles are
+  // partitioned once, each rank advances its own, and the trajectory is bitwise the serial one.
+  // The arrays stay whole on every rank; what observes them calls synchronize() first.
+  explicit Solver(Scene<D>& scene, const SolverSettings& settings = {},
+                  Communicator* comm = nullptr)
       : scene_(scene),
         ref_(buildReferenceConfiguration<D>(scene.particles.referencePosition,
                                             scene.particles.volume, checkedKernel(scene),
@@ -101,6 +118,12 @@ class Solver {
     for (const auto& m : scene.mirrorGhosts)
       if (m.motion >= 0 && scene.prescriptions[m.motion].motion != PrescribedMotion::Fixed)
         movingMirrors_ = true;
+    ownFree_ = free_;
+    for (std::size_t k = 0; k < prescribed_.size(); ++k)
+      ownPrescribed_.push_back(k);
+    for (std::size_t k = 0; k < scene.mirrorGhosts.size(); ++k)
+      ownGhosts_.push_back(k);
+    if (comm && comm->size() > 1) distribute(*comm);
     updateMirrorDrive(0.0);
     mirrorGhostMotion();
     if (forces_.viscosityEnabled()) forceVelocity_ = scene.particles.velocity;
@@ -108,6 +131,22 @@ class Solver {
     chainMirrorForces();
     previousKinetic_ = kineticEnergy(scene.particles);
   }
+
+  // Distributed: every rank's particles onto every rank (displacements, velocities, forces,
+  // F, P, ...), for what observes the whole body (series rows, frames, guards, checkpoints);
+  // once per state. Nothing in a serial run.
+  void synchronize() {
+    if (!comm_ || synchronized_) return;
+    auto& p = scene_.particles;
+    comm_->gatherAll(p.displacement);
+    comm_->gatherAll(p.velocity);
+    comm_->gatherAll(p.force);
+    comm_->gatherAll(forceVelocity_);
+    forces_.gatherAll();
+    synchronized_ = true;
+  }
+  const PartitionSummary& partition() const { return partition_; }
+  Communicator* communicator() const { return comm_; }
 
   double time() const { return time_; }
   double timeStep() const { return dt_; }
@@ -125,8 +164,8 @@ class Solver {
     auto& p = scene_.particles;
     const double halfDt = 0.5 * dt_;
     const double c = scene_.damping.viscous;
-    const Index nFree = static_cast<Index>(free_.size());
-    const Index nPrescribed = static_cast<Index>(prescribed_.size());
+    // This rank's particles (all of them in a serial run).
+    const Index nFree = static_cast<Index>(ownFree_.size());
     // Work is integrated for the non-conservative terms only: the textbook hourglass force
     // and the artificial viscosity (booked as damping). The energy form's E_hg is a state.
     const bool hourglass = !forces_.hourglassForce().empty();
@@ -137,7 +176,7 @@ class Solver {
     // drift: half with the forces before it, half with the forces after it.
     // Sums in a fixed order (OrderedSum.hpp): 0 hourglass, 1 external, 2 damping work.
     const auto kick = orderedSums<3>(nFree, [&](Index k, std::array<double, 3>& w) {
-      const Index i = free_[k];
+      const Index i = ownFree_[k];
       p.velocity[i] += halfDt * (totalForce(i) / p.mass[i] - c * p.velocity[i]);
       const Vec<D> du = dt_ * p.velocity[i];
       p.displacement[i] += du;
@@ -149,7 +188,7 @@ class Solver {
     hourglassWork += kick[0];
     externalWork += kick[1];
     dampingWork += kick[2];
-    for (Index k = 0; k < nPrescribed; ++k) {
+    for (std::size_t k : ownPrescribed_) {
       const Index i = prescribed_[k];
       step_[k] = prescribedMove(k, time_ + dt_) - p.displacement[i];
       p.displacement[i] += step_[k];
@@ -163,23 +202,25 @@ class Solver {
     if (movingMirrors_) {
       driveStep = drive_;
       updateMirrorDrive(time_);
-      for (std::size_t k = 0; k < drive_.size(); ++k) {
+      for (std::size_t k = 0; k < drive_.size(); ++k)
         driveStep[k] = drive_[k] - driveStep[k];
+      for (std::size_t k : ownGhosts_)
         boundaryWork -= 0.5 * p.force[scene_.mirrorGhosts[k].ghost].dot(driveStep[k]);
-      }
     }
     mirrorGhostMotion();
     // The artificial viscosity sees the mid-step velocities.
     if (viscous) forceVelocity_ = p.velocity;
+    exchangeHalo();
     forces_.compute(p.displacement, p.force, &p.velocity);
     chainMirrorForces();
-    for (std::size_t k = 0; k < driveStep.size(); ++k)
-      boundaryWork -= 0.5 * p.force[scene_.mirrorGhosts[k].ghost].dot(driveStep[k]);
+    if (!driveStep.empty())
+      for (std::size_t k : ownGhosts_)
+        boundaryWork -= 0.5 * p.force[scene_.mirrorGhosts[k].ghost].dot(driveStep[k]);
     if (hasExternal_) computeExternalForces(time_);
 
     // 0 hourglass, 1 external, 2 damping work, 3 kinetic energy (fixed order: OrderedSum.hpp).
     const auto kick2 = orderedSums<4>(nFree, [&](Index k, std::array<double, 4>& w) {
-      const Index i = free_[k];
+      const Index i = ownFree_[k];
       const Vec<D> du = dt_ * p.velocity[i];  // still the mid-step velocity
       if (hasExternal_) w[1] += 0.5 * external_[i].dot(du);
       if (hourglass) w[0] += 0.5 * forces_.hourglassForce()[i].dot(du);
@@ -192,16 +233,30 @@ class Solver {
     externalWork += kick2[1];
     dampingWork += kick2[2];
     double kinetic = kick2[3];
-    for (Index k = 0; k < nPrescribed; ++k) {
+    for (std::size_t k : ownPrescribed_) {
       const Index i = prescribed_[k];
       boundaryWork -= 0.5 * p.force[i].dot(step_[k]);
       if (hourglass) hourglassWork += 0.5 * forces_.hourglassForce()[i].dot(step_[k]);
       p.velocity[i] = prescribedVelocity(k, time_);
     }
+    if (comm_) {  // the books are diagnostics: the ranks' parts added in rank order
+      std::array<double, 4> books = {hourglassWork, externalWork, boundaryWork, dampingWork};
+      comm_->sum(books.data(), 4);
+      hourglassWork = books[0];
+      externalWork = books[1];
+      boundaryWork = books[2];
+      dampingWork = books[3];
+    }
 
     if (scene_.damping.kinetic) {
+      // The peak test decides the trajectory: its kinetic energy is summed with bits that do
+      // not depend on the order, the threads or the ranks (ReproducibleSum.hpp).
+      kineticTerms_.resize(ownFree_.size());
+      for (std::size_t k = 0; k < ownFree_.size(); ++k)
+        kineticTerms_[k] = 0.5 * p.mass[ownFree_[k]] * p.velocity[ownFree_[k]].squaredNorm();
+      kinetic = reproducibleSum(kineticTerms_, comm_);
       if (kinetic < previousKinetic_) {  // just past a peak: take the kinetic energy out
-        for (Index i : free_)
+        for (Index i : ownFree_)
           p.velocity[i].setZero();
         dampingWork += kinetic;
         kinetic = 0.0;
@@ -216,9 +271,11 @@ class Solver {
     boundaryWork_ += boundaryWork;
     damped_ += dampingWork;
     ++steps_;
+    synchronized_ = false;
   }
 
   EnergyBalance energyBalance() const {
+    requireSynchronized();
     EnergyBalance e;
     e.kinetic = kineticEnergy(scene_.particles);
     e.strain = forces_.strainEnergy();
@@ -234,6 +291,7 @@ class Solver {
   // Out-of-balance force of a quasi-static run: |sum over free particles of (f_int + f_ext)|_2
   // relative to the size of the forces that hold the body (external loads and reactions).
   double residualRatio() const {
+    requireSynchronized();
     const auto& p = scene_.particles;
     double residual = 0.0, reference = 0.0;
     for (Index i : free_) {
@@ -263,6 +321,7 @@ class Solver {
   // (the internal forces of all particles sum to zero). In equilibrium the reactions balance
   // the loads.
   Vec<D> reaction(std::size_t r) const {
+    requireSynchronized();
     const auto& p = scene_.particles;
     Vec<D> R = Vec<D>::Zero();
     for (Index i : scene_.prescriptions.at(r).particles)
@@ -332,6 +391,7 @@ class Solver {
   }
 
   SolverState<D> state() const {
+    requireSynchronized();
     SolverState<D> s;
     s.time = time_;
     s.steps = steps_;
@@ -371,11 +431,13 @@ class Solver {
     p.velocity = forceVelocity_.empty() ? s.velocity : forceVelocity_;
     updateMirrorDrive(time_);
     mirrorGhostMotion();
+    exchangeHalo();
     forces_.compute(p.displacement, p.force, &p.velocity);
     chainMirrorForces();
     if (hasExternal_) computeExternalForces(time_);
     p.velocity = s.velocity;
     mirrorGhostMotion();
+    synchronized_ = false;
   }
 
   // Recomputes the forces (and the external forces at the current time) for the particles'
@@ -385,9 +447,11 @@ class Solver {
     auto& p = scene_.particles;
     mirrorGhostMotion();
     if (forces_.viscosityEnabled()) forceVelocity_ = p.velocity;
+    exchangeHalo();
     forces_.compute(p.displacement, p.force, &p.velocity);
     chainMirrorForces();
     if (hasExternal_) computeExternalForces(time_);
+    synchronized_ = false;
   }
 
  private:
@@ -463,10 +527,60 @@ class Solver {
   // Serial: two faces' ghosts can share a mirror particle.
   void chainMirrorForces() {
     auto& p = scene_.particles;
-    for (const auto& m : scene_.mirrorGhosts) {
+    for (std::size_t k : ownGhosts_) {  // a ghost and what it follows are on one rank
+      const auto& m = scene_.mirrorGhosts[k];
       p.force[m.mirror] += m.w1 * p.force[m.ghost];
       if (m.second >= 0) p.force[m.second] += m.w2 * p.force[m.ghost];
     }
+  }
+
+  // Partitions the particles among the ranks (on rank 0, broadcast), mirrored ghosts with the
+  // particles they follow, and keeps this rank's share of each particle list.
+  void distribute(Communicator& comm) {
+    comm_ = &comm;
+    const auto& nb = ref_.neighbours;
+    DomainPartition partition;
+    partition.parts = comm.size();
+    std::string method;
+    if (comm.rank() == 0) {
+      partition = partitionParticles<D>(scene_.particles.referencePosition, nb, comm.size());
+      std::vector<std::pair<Index, Index>> links;
+      for (const auto& m : scene_.mirrorGhosts) {
+        links.emplace_back(m.ghost, m.mirror);
+        if (m.second >= 0) links.emplace_back(m.ghost, m.second);
+      }
+      keepTogether(partition, links, nb);
+      method = partition.method;
+    } else {
+      partition.part.assign(static_cast<std::size_t>(nb.particleCount()), 0);
+    }
+    comm.broadcast(partition.part);
+    comm.broadcast(method);
+    if (comm.rank() != 0) completePartition(partition, nb);
+    partition.method = method;
+    comm.setPartition(partition);
+    partition_ = {comm.size(), method, partition.haloTotal(), partition.imbalance(nb)};
+    const auto& owned = partition.owned[comm.rank()];
+    std::vector<std::uint8_t> mine(static_cast<std::size_t>(nb.particleCount()), 0);
+    for (Index i : owned)
+      mine[i] = 1;
+    std::erase_if(ownFree_, [&](Index i) { return !mine[i]; });
+    std::erase_if(ownPrescribed_, [&](std::size_t k) { return !mine[prescribed_[k]]; });
+    std::erase_if(ownGhosts_, [&](std::size_t k) { return !mine[scene_.mirrorGhosts[k].ghost]; });
+    forces_.distribute(owned, comm_);
+  }
+
+  // Distributed: the halo's displacements (and, for the artificial viscosity, velocities)
+  // from their owners, before a force pass.
+  void exchangeHalo() {
+    if (!comm_) return;
+    comm_->exchangeHalo(scene_.particles.displacement);
+    if (forces_.viscosityEnabled()) comm_->exchangeHalo(scene_.particles.velocity);
+  }
+
+  void requireSynchronized() const {
+    if (comm_ && !synchronized_)
+      throw std::logic_error("Solver: observed a distributed run without synchronize()");
   }
 
   static Kernel<D> checkedKernel(const Scene<D>& scene) {
@@ -569,6 +683,14 @@ class Solver {
   ReferenceConfiguration<D> ref_;
   TlsphForces<D> forces_;
   std::vector<Index> free_, prescribed_;
+  // What this rank advances: its free particles, slots of prescribed_ and mirrored ghosts
+  // (all of them in a serial run).
+  std::vector<Index> ownFree_;
+  std::vector<std::size_t> ownPrescribed_, ownGhosts_;
+  Communicator* comm_ = nullptr;
+  bool synchronized_ = false;
+  PartitionSummary partition_;
+  std::vector<double> kineticTerms_;
   std::vector<int> rule_;      // per prescribed particle: index into scene.prescriptions, or -1
   std::vector<Vec<D>> start_;  // per prescribed particle: displacement at the start
   std::vector<Vec<D>> step_;   // per prescribed particle: its displacement over this step

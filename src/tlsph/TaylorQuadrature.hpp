@@ -30,6 +30,7 @@
 #include <vector>
 
 #include "materials/Material.hpp"
+#include "tlsph/Communicator.hpp"
 #include "tlsph/OrderedSum.hpp"
 #include "tlsph/ReferenceConfiguration.hpp"
 #include "tlsph/Types.hpp"
@@ -101,6 +102,11 @@ class TaylorQuadrature {
     R_[i].noalias() = F * symmetric(sigma);  // R_a = F sigma_a, stored symmetric
     return Pq;
   }
+  // Distributed runs: the halo's hyperstresses (read by the force pass), and every rank's
+  // second gradients (read by the energy and the probes).
+  void exchangeHalo(Communicator& comm) { comm.exchangeHalo(R_); }
+  void gatherAll(Communicator& comm) { comm.gatherAll(G_); }
+
   Vec<D> hyperForceOwn(Index i) const { return R_[i] * sum_[i]; }
   Vec<D> hyperForcePair(Index k, Index j) const { return R_[j] * reverse_[k]; }
 

@@ -18,6 +18,7 @@
 
 #include "materials/Material.hpp"
 #include "tlsph/ArtificialViscosity.hpp"
+#include "tlsph/Communicator.hpp"
 #include "tlsph/EnergyHourglass.hpp"
 #include "tlsph/GanzenmuellerHourglass.hpp"
 #include "tlsph/HourglassStiffness.hpp"
@@ -87,6 +88,33 @@ class TlsphForces {
     }
   }
 
+  // A distributed run (issue 11): this rank computes the particles it owns (ascending), and
+  // compute() brings from their owners, through comm, what its pair loops read of the halo.
+  void distribute(const std::vector<Index>& owned, Communicator* comm) {
+    comm_ = comm;
+    owned_ = owned;
+    std::vector<std::uint8_t> mine(ref_.particleCount(), 0);
+    for (Index i : owned)
+      mine[i] = 1;
+    ownedOfMaterial_ = particlesOfMaterial_;
+    for (auto& group : ownedOfMaterial_)
+      std::erase_if(group, [&](Index i) { return !mine[i]; });
+    ownedPassive_ = passive_;
+    std::erase_if(ownedPassive_, [&](Index i) { return !mine[i]; });
+  }
+
+  // Every rank's entries of what observers read (F, P, the hourglass and viscous forces, the
+  // quadrature's second gradients) onto every rank; nothing in a serial run.
+  void gatherAll() {
+    if (!comm_) return;
+    comm_->gatherAll(F_);
+    comm_->gatherAll(P_);
+    comm_->gatherAll(hourglassF_);
+    comm_->gatherAll(hourglassForce_);
+    comm_->gatherAll(viscousForce_);
+    if (quadrature_) quadrature_->gatherAll(*comm_);
+  }
+
   bool hourglassEnabled() const { return hourglass_.enabled(); }
   double hourglassCoefficient() const { return hourglass_.alpha; }
   const HourglassSettings& hourglass() const { return hourglass_; }
@@ -97,17 +125,28 @@ class TlsphForces {
 
   // Overwrites f with the internal plus hourglass (plus viscous) force on every particle,
   // ghosts included (on a prescribed particle it is the reaction). v is needed only with
-  // artificial viscosity.
+  // artificial viscosity. Distributed: on the owned particles, and u (and v) must hold the
+  // halo's values.
   void compute(const std::vector<Vec<D>>& u, std::vector<Vec<D>>& f,
                const std::vector<Vec<D>>* v = nullptr) {
     quadrature_ ? stressPass<true>(u) : stressPass<false>(u);
+    // The penalty reads the neighbours' F (the one it compares with).
+    if (comm_ && hourglass_.enabled())
+      comm_->exchangeHalo(separateHourglassGradient_ ? hourglassF_ : F_);
     // What the force pass sends through g_IJ: P (+ P^q) (+ P^hg of the same F).
     const std::vector<Mat<D>>& PQ = quadrature_ ? quadratureStress_ : P_;
+    const std::vector<Index>* owned = comm_ ? &owned_ : nullptr;
     // P^hg of the linear F goes through the linear gradient vectors: its own sum.
     if (energyHourglass_ && separateHourglassGradient_)
-      energyHourglass_->evaluate(u, hourglassF_, nullptr, stress_);
+      energyHourglass_->evaluate(u, hourglassF_, nullptr, stress_, owned);
     else if (energyHourglass_)
-      energyHourglass_->evaluate(u, F_, &PQ, stress_);
+      energyHourglass_->evaluate(u, F_, &PQ, stress_, owned);
+    if (comm_) {  // the force pass reads the neighbours' stresses (and hyperstresses)
+      if (energyHourglass_) comm_->exchangeHalo(stress_);
+      if (!energyHourglass_ || separateHourglassGradient_)
+        comm_->exchangeHalo(quadrature_ ? quadratureStress_ : P_);
+      if (quadrature_) quadrature_->exchangeHalo(*comm_);
+    }
     const bool viscous = viscosity_ && v != nullptr;
     if (quadrature_)
       forcePass<true>(u, f, v, viscous);
@@ -172,15 +211,16 @@ class TlsphForces {
   // gradients in the same pass when Taylor.
   template <bool Taylor>
   void stressPass(const std::vector<Vec<D>>& u) {
+    const auto& groups = comm_ ? ownedOfMaterial_ : particlesOfMaterial_;
     for (std::size_t m = 0; m < materials_.size(); ++m)
       std::visit(
           [&](const auto& model) {
-            deformationAndStress<std::decay_t<decltype(model)>, Taylor>(&model,
-                                                                        particlesOfMaterial_[m], u);
+            deformationAndStress<std::decay_t<decltype(model)>, Taylor>(&model, groups[m], u);
           },
           materials_[m]);
     // Passive particles (mirrored ghosts): F for the penalty and the output, P stays zero.
-    if (!passive_.empty()) deformationAndStress<void, false>(nullptr, passive_, u);
+    const auto& passive = comm_ ? ownedPassive_ : passive_;
+    if (!passive.empty()) deformationAndStress<void, false>(nullptr, passive, u);
   }
 
   // F (and the penalty's own linear F where it has one) of the particles in group; their
@@ -249,7 +289,9 @@ class TlsphForces {
   void accumulateForces(const std::vector<Vec<D>>& u, std::vector<Vec<D>>& f,
                         const std::vector<Vec<D>>* velocity) {
     const auto& nb = ref_.neighbours;
-    const Index n = ref_.particleCount();
+    // All particles, or (distributed) the owned ones.
+    const Index count = comm_ ? static_cast<Index>(owned_.size()) : ref_.particleCount();
+    const Index* owned = comm_ ? owned_.data() : nullptr;
     // The stress the force pass sends through the gradient vectors: P (+ P^q), or that plus
     // P^hg (or P^hg alone through the linear vectors).
     const std::vector<Mat<D>>& S = energyHourglass_ && !SeparateHourglassStress ? stress_
@@ -258,7 +300,8 @@ class TlsphForces {
     const std::vector<Mat<D>>& Fh = separateHourglassGradient_ ? hourglassF_ : F_;
     [[maybe_unused]] const TaylorQuadrature<D>* q = quadrature_.get();
 #pragma omp parallel for schedule(static)
-    for (Index i = 0; i < n; ++i) {
+    for (Index p = 0; p < count; ++p) {
+      const Index i = owned ? owned[p] : p;
       // (6.70) as a force: f_I = V_I (S_I G_I - sum_J S_J t_IJ)
       Vec<D> internal = S[i] * ref_.correctedGradientSum[i];
       Vec<D> hourglass = Vec<D>::Zero(), viscous = Vec<D>::Zero();
@@ -293,6 +336,10 @@ class TlsphForces {
   }
 
   const ReferenceConfiguration<D>& ref_;
+  Communicator* comm_ = nullptr;  // distributed runs only
+  std::vector<Index> owned_;      // distributed: this rank's particles, ascending
+  std::vector<std::vector<Index>> ownedOfMaterial_;
+  std::vector<Index> ownedPassive_;
   const std::vector<Material>& materials_;
   const std::vector<double>& volume_;
   HourglassSettings hourglass_;

@@ -1,0 +1,73 @@
+// What the solver needs from a distributed run (issue 11), without depending on MPI: the
+// particles are split among ranks once (DomainPartition); each rank advances its own ones and
+// reads a halo of its neighbours' from their owners. The MPI implementation is
+// parallel/MpiCommunicator; a serial run has none (a null Communicator*).
+//
+// Arrays stay indexed by global particle on every rank: a rank computes its own entries,
+// exchangeHalo() brings the entries its particles read (one neighbour layer), gatherAll() every
+// entry (for what observes the whole body: series rows, frames, checks, checkpoints).
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "tlsph/DomainPartition.hpp"
+#include "tlsph/Types.hpp"
+
+namespace tlsph {
+
+class Communicator {
+ public:
+  virtual ~Communicator() = default;
+  virtual int rank() const = 0;
+  virtual int size() const = 0;
+
+  // Builds the communication plan of a partition (the same on every rank). The partition is
+  // made on rank 0 and broadcast (partitionOnRoot), so that every rank holds the same one.
+  virtual void setPartition(const DomainPartition& partition) = 0;
+
+  // Byte-level operations on arrays of `count` particles of `width` bytes each.
+  virtual void exchangeHaloBytes(char* values, std::size_t width) = 0;
+  virtual void gatherAllBytes(char* values, std::size_t width) = 0;
+
+  virtual void sum(double* values, int count) = 0;  // every rank gets the sums (rank order)
+  virtual void max(double* values, int count) = 0;  // every rank gets the maxima
+  virtual void broadcastBytes(char* data, std::size_t bytes) = 0;  // from rank 0
+  virtual void barrier() = 0;
+
+  // Entries of the halo: set to the owners' values; other entries are left as they were.
+  template <class T>
+  void exchangeHalo(std::vector<T>& values) {
+    static_assert(std::is_trivially_destructible_v<T>);  // plain numbers, Eigen fixed-size
+    if (!values.empty()) exchangeHaloBytes(reinterpret_cast<char*>(values.data()), sizeof(T));
+  }
+  // Every entry set to its owner's value.
+  template <class T>
+  void gatherAll(std::vector<T>& values) {
+    static_assert(std::is_trivially_destructible_v<T>);  // plain numbers, Eigen fixed-size
+    if (!values.empty()) gatherAllBytes(reinterpret_cast<char*>(values.data()), sizeof(T));
+  }
+  template <class T>
+  void broadcast(std::vector<T>& values) {
+    static_assert(std::is_trivially_destructible_v<T>);  // plain numbers, Eigen fixed-size
+    if (!values.empty())
+      broadcastBytes(reinterpret_cast<char*>(values.data()), values.size() * sizeof(T));
+  }
+  // Rank 0's string on every rank.
+  void broadcast(std::string& text) {
+    std::vector<long> length = {static_cast<long>(text.size())};
+    broadcast(length);
+    text.resize(static_cast<std::size_t>(length[0]));
+    if (length[0] > 0) broadcastBytes(text.data(), text.size());
+  }
+  // True on every rank when `flag` is true on some rank.
+  bool any(bool flag) {
+    double v = flag ? 1.0 : 0.0;
+    max(&v, 1);
+    return v > 0.0;
+  }
+};
+
+}  // namespace tlsph

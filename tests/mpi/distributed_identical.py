@@ -1,0 +1,296 @@
+#!/usr/bin/python3
+"""A distributed run is the serial run, bit for bit (issue 11).
+
+For each scene below (2D and 3D, covering the clamps' mirrored ghosts, moving clamps,
+prescribed rotation, loads, gravity, probes, kinetic damping with the static stop, artificial
+viscosity, the textbook and energy hourglass forms, the Taylor quadrature and the nodal one),
+`tlsph run` is run serially and under `mpirun -np R` (R given on the command line), and every
+output file is compared:
+  - the VTU frames and probes.csv / reactions.csv: byte for byte (comment lines aside);
+  - energies.csv: byte for byte except the work books (external_work, boundary_work, damped,
+    total, and hourglass for the textbook form), which are sums over the ranks' parts and may
+    differ in the last bits: within 1e-12 of the row's largest book;
+  - summary.json records the ranks, the same steps and outcome.
+A restart from a checkpoint written on R ranks continues bit for bit, and a run that goes
+unstable stops at the same step with the same frames. Exit status 0 when all agree.
+Standard library only; run by ctest as mpi_distributed_R.
+"""
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+
+PROGRAM, MPIEXEC, RANKS = sys.argv[1], sys.argv[2], int(sys.argv[3])
+ENV = dict(os.environ, OMP_NUM_THREADS="1", OMPI_ALLOW_RUN_AS_ROOT="1",
+           OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMPI_MCA_btl_vader_single_copy_mechanism="none")
+
+SCENES = {
+    # 2D cantilever: mirrored clamp, gravity, a tip load, probes (kernel and nearest, stress),
+    # kinetic damping to the static stop, Taylor quadrature, energy penalty.
+    "beam2d": """
+[scene]
+dimension = 2
+dx = 0.01
+[material.steel]
+model = neo-hookean
+density = 1000
+youngs_modulus = 1e6
+poisson_ratio = 0.3
+[body.beam]
+shape = box
+lower = 0 0
+upper = 0.4 0.06
+[clamp.root]
+face = x-
+[region.tip]
+shape = box
+lower = 0.39 0
+upper = 0.41 0.06
+[load.tip]
+region = tip
+type = force
+value = 0 -2
+ramp = 0.05
+[gravity]
+acceleration = 0 -9.81
+[damping]
+kinetic = true
+[static]
+enabled = true
+tolerance = 1e-3
+check_every = 20
+[time]
+end = 0.3
+[output]
+fields = displacement velocity von_mises flags
+every_steps = 150
+series_every_steps = 10
+[probe.tip]
+point = 0.4 0.03
+quantities = displacement velocity cauchy_stress
+[probe.root]
+point = 0.05 0.0
+method = nearest
+""",
+    # 3D plate: four mirrored clamps, a traction, nodal quadrature with the linear correction,
+    # the textbook (Ganzenmueller) hourglass force, viscous damping.
+    "plate3d": """
+[scene]
+dimension = 3
+dx = 0.025
+[material.plate]
+model = saint-venant-kirchhoff
+density = 1000
+youngs_modulus = 1e7
+poisson_ratio = 0.3
+[body.plate]
+shape = box
+lower = 0 0 0
+upper = 0.5 0.4 0.075
+[clamp.left]
+face = x-
+[clamp.right]
+face = x+
+[clamp.front]
+face = y-
+[load.top]
+face = z+
+type = traction
+value = 0 0 -1000
+ramp = 0.002
+[kernel]
+correction = linear
+[hourglass]
+form = ganzenmueller
+alpha = 2
+[damping]
+viscous = 50
+[time]
+end = 0.004
+[output]
+fields = displacement velocity J first_piola
+every_steps = 100
+series_every_steps = 10
+[probe.centre]
+point = 0.25 0.2 0.075
+""",
+    # 3D block: a clamp that rotates, a prescribed velocity region, artificial viscosity, an
+    # initial spin, the energy penalty on the linear F with the quadratic correction.
+    "block3d": """
+[scene]
+dimension = 3
+dx = 0.02
+[material.rubber]
+model = neo-hookean
+density = 1100
+youngs_modulus = 5e5
+poisson_ratio = 0.4
+[body.block]
+shape = box
+lower = 0 0 0
+upper = 0.3 0.12 0.1
+[clamp.left]
+face = x-
+motion = rotation
+axis = 1 0 0
+point = 0 0.06 0.05
+rate = 20
+ramp = 0.005
+[region.end]
+shape = box
+lower = 0.28 0 0
+upper = 0.31 0.13 0.11
+[prescribe.end]
+region = end
+motion = velocity
+value = 0.2 0 0
+ramp = 0.002
+[initial.spin]
+profile = rotation
+axis = 0 0 1
+point = 0.15 0.06 0.05
+rate = 1
+[hourglass]
+gradient = linear
+[artificial_viscosity]
+linear = 0.5
+quadratic = 1.0
+[time]
+end = 0.02
+[output]
+fields = displacement velocity cauchy_stress hourglass_error
+every_steps = 80
+series_every_steps = 10
+hourglass_content = true
+[probe.mid]
+point = 0.15 0.06 0.05
+quantities = displacement velocity
+""",
+}
+
+BOOKS = {"external_work", "boundary_work", "damped", "total"}
+
+
+def run(scene_file, directory, ranks, extra=()):
+    command = [PROGRAM, "run", scene_file, "--output.directory=" + directory, "--overwrite",
+               *extra]
+    if ranks > 0:
+        command = [MPIEXEC, "-np", str(ranks), "--oversubscribe", *command]
+    result = subprocess.run(command, env=ENV, capture_output=True, text=True)
+    return result.returncode, result.stdout + result.stderr
+
+
+def data_lines(path):
+    with open(path) as f:
+        return [line.rstrip("\n") for line in f if not line.startswith("#")]
+
+
+def compare_energies(a, b, books):
+    la, lb = data_lines(a), data_lines(b)
+    if len(la) != len(lb) or la[0] != lb[0]:
+        return "energies.csv: different rows or header"
+    header = la[0].split(",")
+    for ra, rb in zip(la[1:], lb[1:]):
+        va, vb = ra.split(","), rb.split(",")
+        scale = max(abs(float(va[header.index(c)])) for c in books) or 1.0
+        for name, x, y in zip(header, va, vb):
+            if name in books:
+                if abs(float(x) - float(y)) > 1e-12 * scale:
+                    return f"energies.csv: {name} {x} vs {y}"
+            elif x != y:
+                return f"energies.csv: {name} {x} vs {y} (must be bitwise)"
+    return None
+
+
+def compare(serial, distributed, hourglass_book):
+    problems = []
+    names = sorted(n for n in os.listdir(serial) if os.path.isfile(os.path.join(serial, n)))
+    for name in names:
+        a, b = os.path.join(serial, name), os.path.join(distributed, name)
+        if not os.path.exists(b):
+            problems.append(name + " missing")
+        elif name == "summary.json":
+            sa, sb = json.load(open(a)), json.load(open(b))
+            if sb["ranks"] != RANKS or sa["ranks"] != 1:
+                problems.append(f"summary.json: ranks {sa['ranks']} / {sb['ranks']}")
+            for key in ("steps", "outcome", "simulated_time"):
+                if sa[key] != sb[key]:
+                    problems.append(f"summary.json: {key} {sa[key]} vs {sb[key]}")
+        elif name == "energies.csv":
+            books = BOOKS | ({"hourglass"} if hourglass_book else set())
+            why = compare_energies(a, b, books)
+            if why:
+                problems.append(why)
+        elif name.endswith(".csv"):
+            if data_lines(a) != data_lines(b):
+                problems.append(name + " differs")
+        elif open(a, "rb").read() != open(b, "rb").read():
+            problems.append(name + " differs")
+    return problems
+
+
+def main():
+    work = tempfile.mkdtemp(prefix="tlsph_mpi_")
+    failures = 0
+    try:
+        for name, text in SCENES.items():
+            scene = os.path.join(work, name + ".ini")
+            with open(scene, "w") as f:
+                f.write(text)
+            serial, distributed = os.path.join(work, name + "_1"), os.path.join(work, name + "_n")
+            rc1, log1 = run(scene, serial, 0)
+            rcn, logn = run(scene, distributed, RANKS)
+            problems = []
+            if rc1 != rcn:
+                problems.append(f"exit status {rc1} serial, {rcn} on {RANKS} ranks:\n{logn}")
+            if rc1 not in (0, 3):
+                problems.append(f"serial run failed ({rc1}):\n{log1}")
+            problems += compare(serial, distributed, "ganzenmueller" in text)
+            print(f"{name}: {RANKS} ranks: " + ("identical" if not problems else "; ".join(problems)))
+            failures += bool(problems)
+
+        # Restart: the checkpoint a run on RANKS ranks wrote at step 60, continued on RANKS
+        # ranks (the output rewound to that step), ends where the serial run ends.
+        scene = os.path.join(work, "block3d.ini")
+        restarted = os.path.join(work, "restart_n")
+        every = ["--checkpoint.every_steps=60"]
+        rc, log = run(scene, restarted, RANKS, every)
+        checkpoint = os.path.join(restarted, "checkpoints", "block3d_step000000060.ckpt")
+        rc2, log2 = run(scene, restarted, RANKS, every + ["--restart=" + checkpoint])
+        if "(step 60," not in log2:
+            rc2 = -1
+        problems = [] if os.path.exists(checkpoint) and rc == 0 and rc2 == 0 else [
+            f"restart runs failed ({rc}, {rc2}):\n{log}\n{log2}"]
+        if not problems:
+            problems = [p for p in compare(os.path.join(work, "block3d_1"), restarted, False)
+                        if not p.startswith("summary.json")]
+        print(f"restart on {RANKS} ranks: " + ("identical" if not problems else "; ".join(problems)))
+        failures += bool(problems)
+
+        # An unstable run (a step 3x the rule's): same step, cause and frames.
+        scene = os.path.join(work, "beam2d.ini")
+        unstable = ["--time.cfl=1.6", "--damping.kinetic=false", "--static.enabled=false",
+                    "--static.check_every=10"]
+        rc1, log1 = run(scene, os.path.join(work, "unstable_1"), 0, unstable)
+        rcn, logn = run(scene, os.path.join(work, "unstable_n"), RANKS, unstable)
+        problems = []
+        if rc1 != 4 or rcn != 4:
+            problems.append(f"exit status {rc1} / {rcn}, expected 4:\n{log1}\n{logn}")
+        else:
+            problems = compare(os.path.join(work, "unstable_1"), os.path.join(work, "unstable_n"),
+                               False)
+            line1 = [l for l in log1.splitlines() if "unstable at step" in l]
+            linen = [l for l in logn.splitlines() if "unstable at step" in l]
+            if line1 != linen:
+                problems.append(f"messages differ: {line1} / {linen}")
+        print(f"unstable on {RANKS} ranks: " + ("identical" if not problems else "; ".join(problems)))
+        failures += bool(problems)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
