@@ -1,10 +1,30 @@
 // MpiCommunicator (see the header).
 #include "parallel/MpiCommunicator.hpp"
 
+#include <chrono>
 #include <cstdlib>
 #include <cstring>
 
 namespace tlsph {
+
+namespace {
+
+// Adds the wall time of its scope to a Traffic record.
+class Timed {
+ public:
+  Timed(MpiCommunicator::Traffic& t, double bytes) : t_(t), start_(Clock::now()) {
+    ++t.calls;
+    t.bytes += bytes;
+  }
+  ~Timed() { t_.seconds += std::chrono::duration<double>(Clock::now() - start_).count(); }
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  MpiCommunicator::Traffic& t_;
+  Clock::time_point start_;
+};
+
+}  // namespace
 
 MpiCommunicator::MpiCommunicator(MPI_Comm comm) : comm_(comm) {
   MPI_Comm_rank(comm_, &rank_);
@@ -17,11 +37,14 @@ void MpiCommunicator::setPartition(const DomainPartition& partition) {
 }
 
 void MpiCommunicator::exchangeHaloBytes(char* values, std::size_t width) {
-  if (halo_) halo_->exchangeBytes(values, width);
+  if (!halo_) return;
+  Timed timed(haloTraffic_, double(halo_->haloCount() * width));
+  halo_->exchangeBytes(values, width);
 }
 
 void MpiCommunicator::gatherAllBytes(char* values, std::size_t width) {
   if (!halo_) return;
+  Timed timed(gatherTraffic_, 0.0);
   std::vector<int> counts(size_), offsets(size_);
   std::size_t total = 0;
   for (int r = 0; r < size_; ++r) {
@@ -34,6 +57,7 @@ void MpiCommunicator::gatherAllBytes(char* values, std::size_t width) {
   for (std::size_t k = 0; k < mine.size(); ++k)
     std::memcpy(sendBuffer_.data() + k * width, values + mine[k] * width, width);
   receiveBuffer_.resize(total);
+  gatherTraffic_.bytes += double(total - sendBuffer_.size());
   MPI_Allgatherv(sendBuffer_.data(), counts[rank_], MPI_BYTE, receiveBuffer_.data(), counts.data(),
                  offsets.data(), MPI_BYTE, comm_);
   for (int r = 0; r < size_; ++r) {
@@ -45,10 +69,12 @@ void MpiCommunicator::gatherAllBytes(char* values, std::size_t width) {
 }
 
 void MpiCommunicator::sum(double* values, int count) {
+  Timed timed(reductionTraffic_, 8.0 * count);
   MPI_Allreduce(MPI_IN_PLACE, values, count, MPI_DOUBLE, MPI_SUM, comm_);
 }
 
 void MpiCommunicator::max(double* values, int count) {
+  Timed timed(reductionTraffic_, 8.0 * count);
   MPI_Allreduce(MPI_IN_PLACE, values, count, MPI_DOUBLE, MPI_MAX, comm_);
 }
 

@@ -30,12 +30,24 @@ class MpiCommunicator final : public Communicator {
   // Particles received per halo exchange on this rank.
   std::size_t haloCount() const { return halo_ ? halo_->haloCount() : 0; }
 
+  // Wall time spent in each kind of operation on this rank since construction (a blocking
+  // operation's time includes waiting for the slowest rank), and the bytes received.
+  struct Traffic {
+    double seconds = 0.0;
+    long calls = 0;
+    double bytes = 0.0;
+  };
+  const Traffic& haloTraffic() const { return haloTraffic_; }
+  const Traffic& reductionTraffic() const { return reductionTraffic_; }
+  const Traffic& gatherTraffic() const { return gatherTraffic_; }
+
  private:
   MPI_Comm comm_;
   int rank_ = 0, size_ = 1;
   std::unique_ptr<HaloExchange> halo_;
   std::vector<std::vector<Index>> owned_;  // per rank, ascending
   std::vector<char> sendBuffer_, receiveBuffer_;
+  Traffic haloTraffic_, reductionTraffic_, gatherTraffic_;
 };
 
 // True when this process was started by an MPI launcher (mpirun, srun): then `tlsph run`
