@@ -11,16 +11,19 @@ output file is compared:
     total, and hourglass for the textbook form), which are sums over the ranks' parts and may
     differ in the last bits: within 1e-12 of the row's largest book;
   - summary.json records the ranks, the same steps and outcome.
-A restart from a checkpoint written on R ranks continues bit for bit, and a run that goes
-unstable stops at the same step with the same frames. Exit status 0 when all agree.
+A restart from a checkpoint written on R ranks continues bit for bit, on R ranks and serially;
+a run stopped by SIGTERM on R ranks continues bit for bit with --restart=latest; and a run
+that goes unstable stops at the same step with the same frames. Exit status 0 when all agree.
 Standard library only; run by ctest as mpi_distributed_R.
 """
 import json
 import os
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
+import time
 
 PROGRAM, MPIEXEC, RANKS = sys.argv[1], sys.argv[2], int(sys.argv[3])
 ENV = dict(os.environ, OMP_NUM_THREADS="1", OMPI_ALLOW_RUN_AS_ROOT="1",
@@ -267,6 +270,49 @@ def main():
             problems = [p for p in compare(os.path.join(work, "block3d_1"), restarted, False)
                         if not p.startswith("summary.json")]
         print(f"restart on {RANKS} ranks: " + ("identical" if not problems else "; ".join(problems)))
+        failures += bool(problems)
+
+        # The same checkpoint continued serially: a checkpoint holds the whole state, so the
+        # rank count may change at a restart.
+        serial_restart = os.path.join(work, "restart_1")
+        shutil.copytree(restarted, serial_restart)
+        moved = os.path.join(serial_restart, "checkpoints", "block3d_step000000060.ckpt")
+        rc3, log3 = run(scene, serial_restart, 0, every + ["--restart=" + moved])
+        problems = [] if rc3 == 0 and "(step 60," in log3 else [f"serial restart failed:\n{log3}"]
+        if not problems:
+            problems = [p for p in compare(os.path.join(work, "block3d_1"), serial_restart, False)
+                        if not p.startswith("summary.json")]
+        print(f"checkpoint of {RANKS} ranks continued serially: " +
+              ("identical" if not problems else "; ".join(problems)))
+        failures += bool(problems)
+
+        # SIGTERM to mpirun (which passes it on to every rank): all ranks stop at one step,
+        # a checkpoint is written, and --restart=latest ends where the serial run ends.
+        stopped = os.path.join(work, "stopped_n")
+        scene = os.path.join(work, "beam2d.ini")
+        slow = ["--scene.dx=0.005", "--time.end=3", "--static.enabled=false",
+                "--output.every_steps=4000"]
+        rc1, log1 = run(scene, os.path.join(work, "long_1"), 0, slow)
+        command = [MPIEXEC, "-np", str(RANKS), "--oversubscribe", PROGRAM, "run", scene,
+                   "--output.directory=" + stopped, "--overwrite", *slow] if RANKS > 0 else []
+        process = subprocess.Popen(command, env=ENV, stdout=subprocess.PIPE,
+                                   stderr=subprocess.STDOUT, text=True)
+        # Once the run loop has started (its first frame is written), stop it.
+        deadline = time.time() + 120
+        while not os.path.exists(os.path.join(stopped, "beam2d.pvd")) and time.time() < deadline:
+            time.sleep(0.05)
+        time.sleep(0.5)
+        process.send_signal(signal.SIGTERM)
+        out, _ = process.communicate(timeout=120)
+        rc2, log2 = run(scene, stopped, RANKS, slow + ["--restart=latest"])
+        problems = []
+        if "stopped by signal 15" not in out or rc2 != 0 or rc1 != 0:
+            problems.append(f"stop and restart failed ({rc1}, {rc2}):\n{out}\n{log2}")
+        else:
+            problems = [p for p in compare(os.path.join(work, "long_1"), stopped, False)
+                        if not p.startswith("summary.json")]
+        print(f"SIGTERM on {RANKS} ranks and restart: " +
+              ("identical" if not problems else "; ".join(problems)))
         failures += bool(problems)
 
         # An unstable run (a step 3x the rule's): same step, cause and frames.
