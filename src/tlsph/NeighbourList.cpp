@@ -40,12 +40,14 @@ struct CellGrid {
 };
 
 // For each query point, the points within supportRadius (sorted); `self`: the queries are the
-// points, and a point is not its own neighbour.
+// points, and a point is not its own neighbour; `rows` (with self): only those points are
+// queried, list q belonging to point rows[q].
 template <int D>
 NeighbourList search(const std::vector<Vec<D>>& Q, const std::vector<Vec<D>>& X,
-                     double supportRadius, const PeriodicBox<D>& box, bool self) {
+                     double supportRadius, const PeriodicBox<D>& box, bool self,
+                     const std::vector<Index>* rows = nullptr) {
   const Index n = static_cast<Index>(X.size());
-  const Index nq = static_cast<Index>(Q.size());
+  const Index nq = static_cast<Index>(rows ? rows->size() : Q.size());
   NeighbourList list;
   list.offset.assign(nq + 1, 0);
   if (n == 0 || nq == 0) return list;
@@ -98,7 +100,8 @@ NeighbourList search(const std::vector<Vec<D>>& Q, const std::vector<Vec<D>>& X,
   const double r2max = supportRadius * supportRadius;
   std::vector<std::vector<Index>> found(nq);
 #pragma omp parallel for schedule(dynamic, 256)
-  for (Index i = 0; i < nq; ++i) {
+  for (Index q = 0; q < nq; ++q) {
+    const Index i = rows ? (*rows)[q] : q;  // the query point's index in Q
     std::array<Index, D> own;
     for (int a = 0; a < D; ++a)
       own[a] = self ? coordOfParticle[i][a] : grid.coordinate(Q[i], a);
@@ -122,7 +125,7 @@ NeighbourList search(const std::vector<Vec<D>>& Q, const std::vector<Vec<D>>& X,
       axisCount[a] = k;
     }
     std::array<int, D> it{};
-    auto& out = found[i];
+    auto& out = found[q];
     while (true) {
       std::array<Index, D> c;
       for (int a = 0; a < D; ++a)
@@ -164,6 +167,26 @@ NeighbourList buildNeighbourList(const std::vector<Vec<D>>& queries,
   return search<D>(queries, points, supportRadius, box, false);
 }
 
+template <int D>
+NeighbourList buildNeighbourRows(const std::vector<Vec<D>>& X, const std::vector<Index>& rows,
+                                 double supportRadius, const PeriodicBox<D>& box) {
+  const NeighbourList found = search<D>(X, X, supportRadius, box, true, &rows);
+  const Index n = static_cast<Index>(X.size());
+  NeighbourList list;
+  list.offset.assign(n + 1, 0);
+  for (std::size_t q = 0; q < rows.size(); ++q)
+    list.offset[rows[q] + 1] = found.count(static_cast<Index>(q));
+  for (Index i = 0; i < n; ++i)
+    list.offset[i + 1] += list.offset[i];
+  list.neighbour.resize(found.neighbour.size());
+  for (std::size_t q = 0; q < rows.size(); ++q) {
+    const auto from = found.neighbour.begin() + found.offset[q];
+    std::copy(from, from + found.count(static_cast<Index>(q)),
+              list.neighbour.begin() + list.offset[rows[q]]);
+  }
+  return list;
+}
+
 template NeighbourList buildNeighbourList<2>(const std::vector<Vec<2>>&, double,
                                              const PeriodicBox<2>&);
 template NeighbourList buildNeighbourList<3>(const std::vector<Vec<3>>&, double,
@@ -171,6 +194,10 @@ template NeighbourList buildNeighbourList<3>(const std::vector<Vec<3>>&, double,
 template NeighbourList buildNeighbourList<2>(const std::vector<Vec<2>>&, const std::vector<Vec<2>>&,
                                              double, const PeriodicBox<2>&);
 template NeighbourList buildNeighbourList<3>(const std::vector<Vec<3>>&, const std::vector<Vec<3>>&,
+                                             double, const PeriodicBox<3>&);
+template NeighbourList buildNeighbourRows<2>(const std::vector<Vec<2>>&, const std::vector<Index>&,
+                                             double, const PeriodicBox<2>&);
+template NeighbourList buildNeighbourRows<3>(const std::vector<Vec<3>>&, const std::vector<Index>&,
                                              double, const PeriodicBox<3>&);
 
 }  // namespace tlsph

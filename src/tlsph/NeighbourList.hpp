@@ -32,4 +32,11 @@ NeighbourList buildNeighbourList(const std::vector<Vec<D>>& queries,
                                  const std::vector<Vec<D>>& points, double supportRadius,
                                  const PeriodicBox<D>& box = {});
 
+// The lists of the particles `rows` only (ascending), each exactly as buildNeighbourList gives
+// it; the other particles' lists are empty (the offsets span all of X). For a rank of a
+// distributed run that keeps pair data for its own particles and its halo only.
+template <int D>
+NeighbourList buildNeighbourRows(const std::vector<Vec<D>>& X, const std::vector<Index>& rows,
+                                 double supportRadius, const PeriodicBox<D>& box = {});
+
 }  // namespace tlsph

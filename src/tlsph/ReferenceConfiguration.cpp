@@ -50,10 +50,12 @@ std::string conditionMessage(Index i, const std::string& position, Index neighbo
 template <int D>
 ReferenceConfiguration<D> buildReferenceConfiguration(
     const std::vector<Vec<D>>& X, const std::vector<double>& volume, const Kernel<D>& kernel,
-    const PeriodicBox<D>& box, GradientCorrection correction, double minCorrectionCondition) {
+    const PeriodicBox<D>& box, GradientCorrection correction, double minCorrectionCondition,
+    const std::vector<Index>* rows) {
   ReferenceConfiguration<D> ref;
   ref.correction = correction;
-  ref.neighbours = buildNeighbourList<D>(X, kernel.supportRadius(), box);
+  ref.neighbours = rows ? buildNeighbourRows<D>(X, *rows, kernel.supportRadius(), box)
+                        : buildNeighbourList<D>(X, kernel.supportRadius(), box);
   const auto& nb = ref.neighbours;
   const Index n = ref.particleCount();
   const Index pairs = nb.pairCount();
@@ -63,14 +65,18 @@ ReferenceConfiguration<D> buildReferenceConfiguration(
   ref.correctedGradient.resize(pairs);
   ref.reverseGradient.resize(pairs);
   if (correction == GradientCorrection::Quadratic) ref.linearGradient.resize(pairs);
-  ref.correctionInverse.resize(n);
-  ref.gradientSum.resize(n);
-  ref.correctedGradientSum.resize(n);
+  ref.correctionInverse.assign(n, Mat<D>::Zero());
+  ref.gradientSum.assign(n, Vec<D>::Zero());
+  ref.correctedGradientSum.assign(n, Vec<D>::Zero());
   const double H = kernel.supportRadius();
 
+  // The particles built: all, or the rows asked for.
+  const Index built = rows ? static_cast<Index>(rows->size()) : n;
+  auto particle = [&](Index q) { return rows ? (*rows)[q] : q; };
   std::vector<double> condition(n), fitCondition(n, 1.0);
 #pragma omp parallel for schedule(static)
-  for (Index i = 0; i < n; ++i) {
+  for (Index q = 0; q < built; ++q) {
+    const Index i = particle(q);
     Mat<D> L = Mat<D>::Zero();
     Vec<D> s = Vec<D>::Zero();
     for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
@@ -139,7 +145,8 @@ ReferenceConfiguration<D> buildReferenceConfiguration(
     ref.correctedGradientSum[i] = G;
   }
 
-  for (Index i = 0; i < n; ++i) {
+  for (Index q = 0; q < built; ++q) {
+    const Index i = particle(q);
     std::ostringstream position;
     if (condition[i] < minCorrectionCondition) {
       position << X[i].transpose();
@@ -152,7 +159,12 @@ ReferenceConfiguration<D> buildReferenceConfiguration(
       ref.linearFallback.push_back(i);
   }
 
-  ref.reverseGradient = reverseVectors<D>(nb, ref.correctedGradient, volume);
+  if (rows) {
+    ref.rowMask.assign(n, 0);
+    for (Index i : *rows)
+      ref.rowMask[i] = 1;
+  }
+  ref.reverseGradient = reverseVectors<D>(nb, ref.correctedGradient, volume, ref.rows());
   return ref;
 }
 
@@ -160,15 +172,11 @@ void throwAsymmetricNeighbourLists() {
   throw SetupError("internal: neighbour lists are not symmetric");
 }
 
-template ReferenceConfiguration<2> buildReferenceConfiguration<2>(const std::vector<Vec<2>>&,
-                                                                  const std::vector<double>&,
-                                                                  const Kernel<2>&,
-                                                                  const PeriodicBox<2>&,
-                                                                  GradientCorrection, double);
-template ReferenceConfiguration<3> buildReferenceConfiguration<3>(const std::vector<Vec<3>>&,
-                                                                  const std::vector<double>&,
-                                                                  const Kernel<3>&,
-                                                                  const PeriodicBox<3>&,
-                                                                  GradientCorrection, double);
+template ReferenceConfiguration<2> buildReferenceConfiguration<2>(
+    const std::vector<Vec<2>>&, const std::vector<double>&, const Kernel<2>&, const PeriodicBox<2>&,
+    GradientCorrection, double, const std::vector<Index>*);
+template ReferenceConfiguration<3> buildReferenceConfiguration<3>(
+    const std::vector<Vec<3>>&, const std::vector<double>&, const Kernel<3>&, const PeriodicBox<3>&,
+    GradientCorrection, double, const std::vector<Index>*);
 
 }  // namespace tlsph

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -72,16 +73,24 @@ struct ReferenceConfiguration {
   // Quadratic correction only: particles whose neighbourhood cannot carry the quadratic fit
   // (an acute corner, a strip two particles thick) and use the linear g_IJ instead.
   std::vector<Index> linearFallback;
+  // Built for some particles only (buildReferenceConfiguration's rows): 1 for those; empty
+  // when built for all.
+  std::vector<std::uint8_t> rowMask;
 
   Index particleCount() const { return neighbours.particleCount(); }
+  // For reversePairValues: null when every particle has its list.
+  const std::vector<std::uint8_t>* rows() const { return rowMask.empty() ? nullptr : &rowMask; }
 };
 
 // t_IJ = (V_J / V_I) a_JI for every pair (I, J) of the (symmetric, sorted) full lists: the
 // reverse pair's value, so a force -dE/du_I is gathered from I's own list. (J, I) is found by
 // binary search in J's sorted list. Throws SetupError if a list is not symmetric.
+// hasRow (lists built for some particles only, buildNeighbourRows): a pair whose neighbour has
+// no list of its own gets zero.
 template <class Value>
 std::vector<Value> reversePairValues(const NeighbourList& nb, const std::vector<Value>& a,
-                                     const std::vector<double>& volume) {
+                                     const std::vector<double>& volume,
+                                     const std::vector<std::uint8_t>* hasRow = nullptr) {
   std::vector<Value> t(nb.pairCount());
   const Index n = nb.particleCount();
   bool symmetric = true;
@@ -89,6 +98,10 @@ std::vector<Value> reversePairValues(const NeighbourList& nb, const std::vector<
   for (Index i = 0; i < n; ++i)
     for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
       const Index j = nb.neighbour[k];
+      if (hasRow && !(*hasRow)[j]) {
+        t[k] = Value::Zero();
+        continue;
+      }
       const auto first = nb.neighbour.begin() + nb.offset[j];
       const auto last = nb.neighbour.begin() + nb.offset[j + 1];
       const auto at = std::lower_bound(first, last, i);
@@ -104,18 +117,23 @@ std::vector<Value> reversePairValues(const NeighbourList& nb, const std::vector<
 
 template <int D>
 std::vector<Vec<D>> reverseVectors(const NeighbourList& nb, const std::vector<Vec<D>>& g,
-                                   const std::vector<double>& volume) {
-  return reversePairValues(nb, g, volume);
+                                   const std::vector<double>& volume,
+                                   const std::vector<std::uint8_t>* hasRow = nullptr) {
+  return reversePairValues(nb, g, volume, hasRow);
 }
 
 // Smallest accepted reciprocal condition number of L_I (sigma_min / sigma_max).
 inline constexpr double kDefaultMinCorrectionCondition = 1e-6;
 
 // Throws SetupError naming the particle whose L_I is singular or badly conditioned.
+// rows: build the lists and pair data of these particles only (ascending; the others' lists
+// are empty), each row exactly as the whole build gives it, its reverse vectors wherever the
+// neighbour is a row too: a distributed run's own particles and halo.
 template <int D>
 ReferenceConfiguration<D> buildReferenceConfiguration(
     const std::vector<Vec<D>>& X, const std::vector<double>& volume, const Kernel<D>& kernel,
     const PeriodicBox<D>& box = {}, GradientCorrection correction = GradientCorrection::Linear,
-    double minCorrectionCondition = kDefaultMinCorrectionCondition);
+    double minCorrectionCondition = kDefaultMinCorrectionCondition,
+    const std::vector<Index>* rows = nullptr);
 
 }  // namespace tlsph

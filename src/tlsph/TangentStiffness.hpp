@@ -75,7 +75,7 @@ class TangentStiffness {
       penalty_ = std::make_unique<EnergyHourglass<D>>(ref, c_, volume);
       separate_ = hourglass.gradient == HourglassGradient::Linear && !ref.linearGradient.empty();
       if (separate_) {
-        linearReverse_ = reverseVectors<D>(ref.neighbours, ref.linearGradient, volume);
+        linearReverse_ = reverseVectors<D>(ref.neighbours, ref.linearGradient, volume, ref.rows());
         linearSum_.assign(n_, Vec<D>::Zero());
         for (Index i = 0; i < n_; ++i)
           for (Index k = ref.neighbours.offset[i]; k < ref.neighbours.offset[i + 1]; ++k)

@@ -41,7 +41,9 @@ TaylorQuadrature<D>::TaylorQuadrature(const ReferenceConfiguration<D>& ref,
       mu_[i] = c.mu;
       smallStrain_[i] = std::holds_alternative<LinearElastic>(materials[materialOf[i]]);
     }
-    if (ref.correction != GradientCorrection::Quadratic || fallback[i]) continue;
+    // (no list: a particle this rank keeps no pair data for)
+    if (ref.correction != GradientCorrection::Quadratic || fallback[i] || nb.count(i) == 0)
+      continue;
     // The fit of ReferenceConfiguration (scale-free: the basis is scaled by l for conditioning).
     const double l = std::pow(volume[i], 1.0 / D);
     auto basis = [&](Index k) -> Basis { return quadraticBasis<D>(-ref.separation[k] / l); };
@@ -67,7 +69,7 @@ TaylorQuadrature<D>::TaylorQuadrature(const ReferenceConfiguration<D>& ref,
     }
   }
   // T_IJ = (V_J / V_I) S_JI
-  reverse_ = reversePairValues(nb, S_, volume);
+  reverse_ = reversePairValues(nb, S_, volume, ref.rows());
   G_.assign(n, SymMatrix::Zero());
   R_.assign(n, SymMatrix::Zero());
   force_.assign(n, Vec<D>::Zero());

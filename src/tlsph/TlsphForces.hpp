@@ -263,7 +263,7 @@ class TlsphForces {
   // the stress uses the quadratic correction.
   void linearReverseGradients(const std::vector<double>& volume) {
     const auto& nb = ref_.neighbours;
-    linearReverse_ = reverseVectors<D>(nb, ref_.linearGradient, volume);
+    linearReverse_ = reverseVectors<D>(nb, ref_.linearGradient, volume, ref_.rows());
     linearSum_.assign(ref_.particleCount(), Vec<D>::Zero());
     for (Index i = 0; i < ref_.particleCount(); ++i)
       for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k)
