@@ -23,7 +23,7 @@ class PartsCommunicator final : public Communicator {
   explicit PartsCommunicator(int parts) : parts_(parts) {}
   int rank() const override { return 0; }
   int size() const override { return parts_; }
-  void setPartition(const DomainPartition&) override {}
+  void setPartition(const DomainPartition&, const NeighbourList&) override {}
   void exchangeHaloBytes(char*, std::size_t) override {}
   void gatherAllBytes(char*, std::size_t) override {}
   // Collected from every part before the combined result is handed back (see sumOverParts).

@@ -2,6 +2,8 @@
 // only those the scene asked for.
 #pragma once
 
+#include <algorithm>
+
 #include <cmath>
 #include <string>
 #include <vector>
@@ -16,10 +18,13 @@ namespace tlsph {
 // the pair's current separation and the one F predicts; large where hourglass modes grow.
 template <int D>
 std::vector<double> hourglassError(const ReferenceConfiguration<D>& ref,
-                                   const std::vector<Vec<D>>& u, const std::vector<Mat<D>>& F) {
+                                   const std::vector<Vec<D>>& u, const std::vector<Mat<D>>& F,
+                                   const std::vector<Index>* particles = nullptr) {
   const auto& nb = ref.neighbours;
   std::vector<double> out(ref.particleCount(), 0.0);
-  for (Index i = 0; i < ref.particleCount(); ++i) {
+  const Index count = particles ? static_cast<Index>(particles->size()) : ref.particleCount();
+  for (Index p = 0; p < count; ++p) {
+    const Index i = particles ? (*particles)[p] : p;
     double sum = 0.0, weight = 0.0;
     for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
       const Index j = nb.neighbour[k];
@@ -57,9 +62,25 @@ inline const std::vector<std::string>& allFrameFields() {
   return names;
 }
 
+// The hourglass_error field of every particle when `fields` asks for it (else empty). A
+// distributed rank keeps pair data for its own particles only: each computes theirs and the
+// field is gathered, so every rank calls this (after Solver::synchronize()).
+template <int D>
+std::vector<double> hourglassErrorField(const SceneSetup<D>& setup, const Solver<D>& solver,
+                                        const std::vector<std::string>& fields) {
+  if (std::find(fields.begin(), fields.end(), "hourglass_error") == fields.end()) return {};
+  std::vector<double> out =
+      hourglassError<D>(solver.reference(), setup.scene.particles.displacement,
+                        solver.forces().deformationGradient(), solver.ownedParticles());
+  if (Communicator* comm = solver.communicator()) comm->gatherAll(out);
+  return out;
+}
+
+// hourglassError: the field from hourglassErrorField (computed here when null).
 template <int D>
 Frame makeFrame(const SceneSetup<D>& setup, const Solver<D>& solver,
-                const std::vector<std::string>& fields) {
+                const std::vector<std::string>& fields,
+                const std::vector<double>* hourglassErrorValues = nullptr) {
   const auto& p = setup.scene.particles;
   const Index n = p.size();
   Frame frame;
@@ -108,7 +129,10 @@ Frame makeFrame(const SceneSetup<D>& setup, const Solver<D>& solver,
       frame.fields.push_back(std::move(f));
     } else if (name == "hourglass_error") {
       frame.fields.push_back(
-          PointField{name, 1, hourglassError<D>(solver.reference(), p.displacement, F)});
+          PointField{name, 1,
+                     hourglassErrorValues && !hourglassErrorValues->empty()
+                         ? *hourglassErrorValues
+                         : hourglassError<D>(solver.reference(), p.displacement, F)});
     } else if (name == "flags") {
       frame.flags.push_back(PointFlags{"ghost", setup.ghost});
       std::vector<std::uint8_t> prescribed(n);
@@ -119,12 +143,6 @@ Frame makeFrame(const SceneSetup<D>& setup, const Solver<D>& solver,
     }
   }
   return frame;
-}
-
-// The fields the scene asked for.
-template <int D>
-Frame makeFrame(const SceneSetup<D>& setup, const Solver<D>& solver) {
-  return makeFrame(setup, solver, setup.output.fields);
 }
 
 }  // namespace tlsph

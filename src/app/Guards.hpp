@@ -243,17 +243,19 @@ class RunGuard {
     found.failedFrame = dir / (setup_.name + "_failed.vtu");
     found.lastGoodFrame = dir / (setup_.name + "_last_good.vtu");
     solver_.synchronize();
+    std::vector<double> error = hourglassErrorField(setup_, solver_, allFrameFields());
     if (root) {
       fs::create_directories(dir);
-      writeVtuFile(makeFrame(setup_, solver_, allFrameFields()), found.failedFrame);
+      writeVtuFile(makeFrame(setup_, solver_, allFrameFields(), &error), found.failedFrame);
     }
     auto& p = setup_.scene.particles;
     p.displacement = last_.displacement;
     p.velocity = last_.velocity;
     solver_.reevaluate();
     solver_.synchronize();
+    error = hourglassErrorField(setup_, solver_, allFrameFields());
     if (!root) return;
-    Frame good = makeFrame(setup_, solver_, allFrameFields());
+    Frame good = makeFrame(setup_, solver_, allFrameFields(), &error);
     good.time = last_.time;
     good.step = last_.step;
     writeVtuFile(good, found.lastGoodFrame);
@@ -314,12 +316,16 @@ class RunGuard {
   // Share of the kinetic energy of the free particles in v_I - <v>_I, <v>_I the kernel-weighted
   // mean velocity of I's neighbours: near 0 for smooth fields, near 1 or more for a particle-
   // scale (checkerboard) pattern.
+  // Distributed: a collective (each rank sums its own particles, whose lists it keeps).
   double roughness(const std::vector<Vec<D>>& v) const {
     const auto& p = setup_.scene.particles;
     const auto& ref = solver_.reference();
     const auto& nb = ref.neighbours;
-    double rough = 0.0, all = 0.0;
-    for (Index i = 0; i < p.size(); ++i) {
+    const auto* owned = solver_.ownedParticles();
+    const Index count = owned ? static_cast<Index>(owned->size()) : p.size();
+    std::vector<double> roughParts, allParts;
+    for (Index q = 0; q < count; ++q) {
+      const Index i = owned ? (*owned)[q] : q;
       if (p.motion[i] != Motion::Free || !v[i].allFinite()) continue;
       Vec<D> mean = Vec<D>::Zero();
       double weight = 0.0;
@@ -328,9 +334,11 @@ class RunGuard {
         weight += ref.kernelValue[k];
       }
       if (weight > 0.0) mean /= weight;
-      rough += p.mass[i] * (v[i] - mean).squaredNorm();
-      all += p.mass[i] * v[i].squaredNorm();
+      roughParts.push_back(p.mass[i] * (v[i] - mean).squaredNorm());
+      allParts.push_back(p.mass[i] * v[i].squaredNorm());
     }
+    const double rough = reproducibleSum(roughParts, solver_.communicator()),
+                 all = reproducibleSum(allParts, solver_.communicator());
     return all > 0.0 && std::isfinite(rough) ? rough / all : 0.0;
   }
 
@@ -370,9 +378,8 @@ class RunGuard {
   bool isNeighbourOrSelf(Index i, Index j) const {
     if (i == j) return true;
     if (i < 0 || j < 0) return false;
-    const auto& nb = solver_.reference().neighbours;
-    for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k)
-      if (nb.neighbour[k] == j) return true;
+    for (Index k : solver_.neighboursOf(i))
+      if (k == j) return true;
     return false;
   }
 
@@ -380,9 +387,8 @@ class RunGuard {
   std::string surroundings(Index i) const {
     if (i < 0) return {};
     std::uint8_t flags = near_[i];
-    const auto& nb = solver_.reference().neighbours;
-    for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k)
-      flags |= near_[nb.neighbour[k]];
+    for (Index j : solver_.neighboursOf(i))
+      flags |= near_[j];
     std::string what;
     auto add = [&](const char* w) {
       if (!what.empty()) what += ", ";

@@ -15,24 +15,6 @@
 
 namespace tlsph {
 
-struct NeighbourStats {
-  Index min = 0, max = 0;
-  double mean = 0.0;
-};
-
-template <int D>
-NeighbourStats neighbourStats(const Solver<D>& solver, Index n) {
-  const auto& nb = solver.reference().neighbours;
-  NeighbourStats s;
-  s.min = n > 0 ? nb.count(0) : 0;
-  for (Index i = 0; i < n; ++i) {
-    s.min = std::min(s.min, nb.count(i));
-    s.max = std::max(s.max, nb.count(i));
-  }
-  s.mean = n > 0 ? double(nb.pairCount()) / n : 0.0;
-  return s;
-}
-
 inline const char* outcomeName(RunOutcome o) {
   switch (o) {
     case RunOutcome::Finished:

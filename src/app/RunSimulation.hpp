@@ -197,7 +197,8 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
       std::vector<Mat<D>> H = solver.forces().deformationGradient();
       for (auto& h : H)
         h -= Mat<D>::Identity();
-      row.push_back(hourglassContent(solver.reference(), p.volume, p.displacement, H));
+      row.push_back(hourglassContent(solver.reference(), p.volume, p.displacement, H,
+                                     solver.ownedParticles(), solver.communicator()));
     }
     energies.append(row);
     if (probes) probes->append(probeRow(setup, solver));
@@ -229,8 +230,10 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
   double nextFrameTime = out.everyTime;
   auto writeFrame = [&] {
     solver.synchronize();
-    if (!out.fields.empty() && lastFrameStep != solver.stepCount())
-      writing([&] { vtu->write(makeFrame(setup, solver)); });
+    if (!out.fields.empty() && lastFrameStep != solver.stepCount()) {
+      const auto hourglassError = hourglassErrorField(setup, solver, setup.output.fields);
+      writing([&] { vtu->write(makeFrame(setup, solver, setup.output.fields, &hourglassError)); });
+    }
     lastFrameStep = solver.stepCount();
     flushSeries();
   };

@@ -86,7 +86,7 @@ struct RunFlags {
 template <int D>
 void printSetup(const SceneSetup<D>& setup, const Solver<D>& solver) {
   const auto& p = setup.scene.particles;
-  const NeighbourStats nb = neighbourStats(solver, p.size());
+  const NeighbourStats nb = solver.neighbourStats();
   Index ghosts = 0;
   for (Index i = 0; i < p.size(); ++i)
     ghosts += setup.ghost[i];
@@ -201,14 +201,13 @@ void printSetup(const SceneSetup<D>& setup, const Solver<D>& solver) {
 // Warnings only the solver's set-up can give (added to the scene's, for summary.json).
 template <int D>
 void addSolverWarnings(SceneSetup<D>& setup, const Solver<D>& solver, const std::string& command) {
-  const auto& fallback = solver.reference().linearFallback;
-  if (fallback.empty()) return;
-  const Index i = fallback.front();
+  const FallbackSummary& fallback = solver.linearFallback();
+  if (fallback.count == 0) return;
+  const Index i = fallback.first;
   std::ostringstream w;
-  w << setup.sourceFile << ": [kernel] correction: " << fallback.size() << " of "
+  w << setup.sourceFile << ": [kernel] correction: " << fallback.count << " of "
     << setup.scene.particles.size() << " particles (e.g. particle " << i << " at ("
-    << setup.scene.particles.referencePosition[i].transpose() << ") with "
-    << solver.reference().neighbours.count(i)
+    << setup.scene.particles.referencePosition[i].transpose() << ") with " << fallback.neighbours
     << " neighbours) have too few neighbours on two levels for the quadratic correction's fit "
        "(an acute corner, a strip two particles thick); they use the linear correction (6.69), "
        "exact for affine fields only. Raise [kernel] support (2.3 serves Cook's membrane) to "
@@ -307,7 +306,7 @@ int runOrCheck(const Config& config, bool run, bool progress, const std::string&
           onRoot(comm, [&] {
             checkFreeSpace(setup.output.directory, estimateOutput(setup, solver.timeStep()));
           });
-        neighbours = neighbourStats(solver, setup.scene.particles.size());
+        neighbours = solver.neighbourStats();
       },
       resume ? &*resume : nullptr);
   const std::filesystem::path record =

@@ -7,7 +7,8 @@
 
 namespace tlsph {
 
-HaloExchange::HaloExchange(MPI_Comm comm, const DomainPartition& partition) {
+HaloExchange::HaloExchange(MPI_Comm comm, const DomainPartition& partition,
+                           const NeighbourList& nb) {
   int size = 1;
   MPI_Comm_rank(comm, &rank_);
   MPI_Comm_size(comm, &size);
@@ -16,14 +17,20 @@ HaloExchange::HaloExchange(MPI_Comm comm, const DomainPartition& partition) {
                                 std::to_string(partition.parts) + " parts on " +
                                 std::to_string(size) + " ranks");
   const auto& part = partition.part;
-  // Receive: my halo, by owner. Send: my particles in each other part's halo. Both ascending.
+  // Receive: my halo, by owner. Send: my particles in each other part's halo (those with a
+  // neighbour there). Both ascending.
   std::vector<std::vector<Index>> receive(size), send(size);
-  for (Index j : partition.halo[rank_])
-    receive[part[j]].push_back(j);
-  for (int q = 0; q < size; ++q)
-    if (q != rank_)
-      for (Index j : partition.halo[q])
-        if (part[j] == rank_) send[q].push_back(j);
+  for (Index i : partition.owned[rank_])
+    for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
+      const int q = part[nb.neighbour[k]];
+      if (q == rank_) continue;
+      receive[q].push_back(nb.neighbour[k]);
+      if (send[q].empty() || send[q].back() != i) send[q].push_back(i);
+    }
+  for (auto& r : receive) {
+    std::sort(r.begin(), r.end());
+    r.erase(std::unique(r.begin(), r.end()), r.end());
+  }
   for (int q = 0; q < size; ++q) {
     if (receive[q].empty() && send[q].empty()) continue;
     neighbours_.push_back(q);

@@ -21,9 +21,10 @@ namespace tlsph {
 
 class HaloExchange {
  public:
-  // Every rank passes the same partition (built identically from the same scene); its number of
-  // parts must be the communicator's size.
-  HaloExchange(MPI_Comm comm, const DomainPartition& partition);
+  // Every rank passes the same partition (its `part` and `owned`; the halos are found here);
+  // its number of parts must be the communicator's size. nb holds at least the lists of this
+  // rank's particles: what they read, and (the lists are symmetric) who reads them.
+  HaloExchange(MPI_Comm comm, const DomainPartition& partition, const NeighbourList& nb);
   ~HaloExchange();
   HaloExchange(const HaloExchange&) = delete;
   HaloExchange& operator=(const HaloExchange&) = delete;

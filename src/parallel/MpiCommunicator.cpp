@@ -31,8 +31,8 @@ MpiCommunicator::MpiCommunicator(MPI_Comm comm) : comm_(comm) {
   MPI_Comm_size(comm_, &size_);
 }
 
-void MpiCommunicator::setPartition(const DomainPartition& partition) {
-  halo_ = std::make_unique<HaloExchange>(comm_, partition);
+void MpiCommunicator::setPartition(const DomainPartition& partition, const NeighbourList& nb) {
+  halo_ = std::make_unique<HaloExchange>(comm_, partition, nb);
   owned_ = partition.owned;
 }
 

@@ -19,7 +19,7 @@ class MpiCommunicator final : public Communicator {
 
   int rank() const override { return rank_; }
   int size() const override { return size_; }
-  void setPartition(const DomainPartition& partition) override;
+  void setPartition(const DomainPartition& partition, const NeighbourList& nb) override;
   void exchangeHaloBytes(char* values, std::size_t width) override;
   void gatherAllBytes(char* values, std::size_t width) override;
   void sum(double* values, int count) override;

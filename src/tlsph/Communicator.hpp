@@ -24,9 +24,9 @@ class Communicator {
   virtual int rank() const = 0;
   virtual int size() const = 0;
 
-  // Builds the communication plan of a partition (the same on every rank). The partition is
-  // made on rank 0 and broadcast (partitionOnRoot), so that every rank holds the same one.
-  virtual void setPartition(const DomainPartition& partition) = 0;
+  // Builds the communication plan of a partition (the same `part` on every rank: made on rank
+  // 0 and broadcast); nb holds at least the lists of this rank's particles.
+  virtual void setPartition(const DomainPartition& partition, const NeighbourList& nb) = 0;
 
   // Byte-level operations on arrays of `count` particles of `width` bytes each.
   virtual void exchangeHaloBytes(char* values, std::size_t width) = 0;

@@ -9,6 +9,7 @@
 #include "tlsph/OrderedSum.hpp"
 #include "tlsph/Particles.hpp"
 #include "tlsph/ReferenceConfiguration.hpp"
+#include "tlsph/ReproducibleSum.hpp"
 #include "tlsph/Types.hpp"
 
 namespace tlsph {
@@ -27,20 +28,31 @@ double kineticEnergy(const ParticleSet<D>& p) {
 // the share of the neighbours' relative displacement that the smooth field does not explain:
 // 0 for affine fields (with the quadratic correction, quadratic ones), near 1 for a zig-zag.
 template <int D>
+// Distributed: over `particles` (a rank's own, whose pair data it keeps), summed over the ranks
+// with the bits of a serial sum (ReproducibleSum.hpp).
 double hourglassContent(const ReferenceConfiguration<D>& ref, const std::vector<double>& volume,
-                        const std::vector<Vec<D>>& u, const std::vector<Mat<D>>& H) {
+                        const std::vector<Vec<D>>& u, const std::vector<Mat<D>>& H,
+                        const std::vector<Index>* particles = nullptr,
+                        Communicator* comm = nullptr) {
   const auto& nb = ref.neighbours;
-  const Index n = ref.particleCount();
-  const auto s = orderedSums<2>(n, [&](Index i, std::array<double, 2>& sums) {
+  const Index count = particles ? static_cast<Index>(particles->size()) : ref.particleCount();
+  std::vector<double> error(static_cast<std::size_t>(count)), all(error.size());
+#pragma omp parallel for schedule(static)
+  for (Index p = 0; p < count; ++p) {
+    const Index i = particles ? (*particles)[p] : p;
+    double e = 0.0, a = 0.0;
     for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
       const Index j = nb.neighbour[k];
       const double w = ref.kernelValue[k] * volume[j];
       const Vec<D> d = u[i] - u[j];
-      sums[0] += w * (d - 0.5 * (H[i] + H[j]) * ref.separation[k]).squaredNorm();
-      sums[1] += w * d.squaredNorm();
+      e += w * (d - 0.5 * (H[i] + H[j]) * ref.separation[k]).squaredNorm();
+      a += w * d.squaredNorm();
     }
-  });
-  return s[1] > 0.0 ? s[0] / s[1] : 0.0;
+    error[p] = e;
+    all[p] = a;
+  }
+  const double s0 = reproducibleSum(error, comm), s1 = reproducibleSum(all, comm);
+  return s1 > 0.0 ? s0 / s1 : 0.0;
 }
 
 template <int D>

@@ -10,8 +10,8 @@
 
 #include <vector>
 
-#include "tlsph/OrderedSum.hpp"
 #include "tlsph/ReferenceConfiguration.hpp"
+#include "tlsph/ReproducibleSum.hpp"
 #include "tlsph/Types.hpp"
 
 namespace tlsph {
@@ -83,11 +83,16 @@ class EnergyHourglass {
   }
 
   // E_hg = 1/4 sum_I V_I sum_J c_IJ |e_IJ|^2 for the displacements u and gradients F
-  // (a diagnostic pass, not part of the force).
-  double energy(const std::vector<Vec<D>>& u, const std::vector<Mat<D>>& F) const {
+  // (a diagnostic pass, not part of the force). Distributed: each rank its particles', summed
+  // over the ranks with the same bits as a serial sum (ReproducibleSum.hpp).
+  double energy(const std::vector<Vec<D>>& u, const std::vector<Mat<D>>& F,
+                const std::vector<Index>* particles = nullptr, Communicator* comm = nullptr) const {
     const auto& nb = ref_.neighbours;
-    const Index n = ref_.particleCount();
-    return orderedSum(n, [&](Index i) {
+    const Index count = particles ? static_cast<Index>(particles->size()) : ref_.particleCount();
+    std::vector<double> terms(static_cast<std::size_t>(count));
+#pragma omp parallel for schedule(static)
+    for (Index p = 0; p < count; ++p) {
+      const Index i = particles ? (*particles)[p] : p;
       double squares = 0.0;
       for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
         const Index j = nb.neighbour[k];
@@ -95,8 +100,9 @@ class EnergyHourglass {
         const Vec<D> e = (u[i] - u[j]) - 0.5 * ((F[i] + F[j]) * Xij - 2.0 * Xij);
         squares += c_[k] * e.squaredNorm();
       }
-      return 0.25 * volume_[i] * squares;
-    });
+      terms[p] = 0.25 * volume_[i] * squares;
+    }
+    return reproducibleSum(terms, comm);
   }
 
  private:

@@ -2,8 +2,11 @@
 // conditions, loads and damping, and keeping the energy books.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <iterator>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -67,6 +70,28 @@ struct PartitionSummary {
   double imbalance = 1.0;         // largest rank's pairs + particles over the mean
 };
 
+// Neighbours per particle over the whole body.
+struct NeighbourStats {
+  Index min = 0, max = 0;
+  double mean = 0.0;
+};
+
+// The particles the quadratic correction's fit could not serve (ReferenceConfiguration's
+// linearFallback), over the whole body: how many, the first, and its neighbour count.
+struct FallbackSummary {
+  Index count = 0, first = -1, neighbours = 0;
+};
+
+// A distributed run's split, made before the pair data is built (the pair data is kept for
+// this rank's particles and halo only).
+struct DistributionPlan {
+  bool active = false;        // more than one rank
+  DomainPartition partition;  // every rank's part and particles; this rank's halo
+  std::vector<Index> rows;    // this rank's particles and halo, ascending
+  PartitionSummary summary;
+  NeighbourStats neighbours;  // of the whole body
+};
+
 template <int D>
 class Solver {
  public:
@@ -77,15 +102,21 @@ class Solver {
   explicit Solver(Scene<D>& scene, const SolverSettings& settings = {},
                   Communicator* comm = nullptr)
       : scene_(scene),
-        ref_(buildReferenceConfiguration<D>(scene.particles.referencePosition,
-                                            scene.particles.volume, checkedKernel(scene),
-                                            scene.periodicBox, scene.gradientCorrection)),
+        plan_(planDistribution(scene, comm)),
+        ref_(buildReference(scene, plan_, comm)),
         forces_(ref_, scene.materials, scene.particles.material, scene.particles.volume,
                 scene.hourglass(), scene.quadrature, scene.viscosity, 0.5 * scene.supportRadius,
                 mirrorGhostList(scene)) {
     if (!(settings.cfl > 0.0)) throw SetupError("the CFL number must be positive");
     const auto& p = scene.particles;
-    stable_ = stableStep(p, scene.materials, settings.cfl, forces_.hourglassStiffness());
+    if (plan_.active) {
+      comm_ = comm;
+      stable_ = globalStableStep(stableStep(p, scene.materials, settings.cfl,
+                                            forces_.hourglassStiffness(),
+                                            &plan_.partition.owned[comm->rank()]));
+    } else {
+      stable_ = stableStep(p, scene.materials, settings.cfl, forces_.hourglassStiffness());
+    }
     dt_ = settings.timeStep > 0.0 ? settings.timeStep : stable_.dt;
     std::vector<int> slot(p.size(), -1);
     for (Index i = 0; i < p.size(); ++i) {
@@ -123,7 +154,8 @@ class Solver {
       ownPrescribed_.push_back(k);
     for (std::size_t k = 0; k < scene.mirrorGhosts.size(); ++k)
       ownGhosts_.push_back(k);
-    if (comm && comm->size() > 1) distribute(*comm);
+    if (comm_) distribute();
+    summariseFallback();
     updateMirrorDrive(0.0);
     mirrorGhostMotion();
     if (forces_.viscosityEnabled()) forceVelocity_ = scene.particles.velocity;
@@ -145,8 +177,38 @@ class Solver {
     forces_.gatherAll();
     synchronized_ = true;
   }
-  const PartitionSummary& partition() const { return partition_; }
+  const PartitionSummary& partition() const { return plan_.summary; }
   Communicator* communicator() const { return comm_; }
+  // Distributed: this rank's particles (ascending); null in a serial run (all of them).
+  const std::vector<Index>* ownedParticles() const {
+    return comm_ ? &plan_.partition.owned[comm_->rank()] : nullptr;
+  }
+  // Neighbours per particle over the whole body.
+  NeighbourStats neighbourStats() const {
+    if (comm_) return plan_.neighbours;
+    const auto& nb = ref_.neighbours;
+    const Index n = nb.particleCount();
+    NeighbourStats s;
+    s.min = n > 0 ? nb.count(0) : 0;
+    for (Index i = 0; i < n; ++i) {
+      s.min = std::min(s.min, nb.count(i));
+      s.max = std::max(s.max, nb.count(i));
+    }
+    s.mean = n > 0 ? double(nb.pairCount()) / n : 0.0;
+    return s;
+  }
+  const FallbackSummary& linearFallback() const { return fallback_; }
+  // The reference neighbours of particle i (a distributed rank keeps lists for its particles
+  // and halo only; another particle's is searched for).
+  std::vector<Index> neighboursOf(Index i) const {
+    const auto& nb = ref_.neighbours;
+    if (!comm_ || nb.count(i) > 0)
+      return {nb.neighbour.begin() + nb.offset[i], nb.neighbour.begin() + nb.offset[i + 1]};
+    const NeighbourList one =
+        buildNeighbourRows<D>(scene_.particles.referencePosition, {i},
+                              checkedKernel(scene_).supportRadius(), scene_.periodicBox);
+    return {one.neighbour.begin() + one.offset[i], one.neighbour.begin() + one.offset[i + 1]};
+  }
 
   double time() const { return time_; }
   double timeStep() const { return dt_; }
@@ -534,40 +596,145 @@ class Solver {
     }
   }
 
-  // Partitions the particles among the ranks (on rank 0, broadcast), mirrored ghosts with the
-  // particles they follow, and keeps this rank's share of each particle list.
-  void distribute(Communicator& comm) {
-    comm_ = &comm;
-    const auto& nb = ref_.neighbours;
-    DomainPartition partition;
-    partition.parts = comm.size();
+  // Splits the particles among the ranks (on rank 0, from the whole neighbour graph, which
+  // only it builds; broadcast), mirrored ghosts with the particles they follow; this rank's
+  // halo from its particles' lists; the communication plan. Empty for a serial run.
+  static DistributionPlan planDistribution(const Scene<D>& scene, Communicator* comm) {
+    DistributionPlan plan;
+    if (!comm || comm->size() <= 1) return plan;
+    plan.active = true;
+    const auto& X = scene.particles.referencePosition;
+    const Index n = scene.particles.size();
+    const double H = checkedKernel(scene).supportRadius();
+    const int rank = comm->rank(), size = comm->size();
+    auto& partition = plan.partition;
     std::string method;
-    if (comm.rank() == 0) {
-      partition = partitionParticles<D>(scene_.particles.referencePosition, nb, comm.size());
+    std::vector<double> numbers(5, 0.0);  // halo, imbalance, neighbours min, mean, max
+    if (rank == 0) {
+      const NeighbourList nb = buildNeighbourList<D>(X, H, scene.periodicBox);
+      partition = partitionParticles<D>(X, nb, size);
       std::vector<std::pair<Index, Index>> links;
-      for (const auto& m : scene_.mirrorGhosts) {
+      for (const auto& m : scene.mirrorGhosts) {
         links.emplace_back(m.ghost, m.mirror);
         if (m.second >= 0) links.emplace_back(m.ghost, m.second);
       }
       keepTogether(partition, links, nb);
       method = partition.method;
+      Index least = n > 0 ? nb.count(0) : 0, most = 0;
+      for (Index i = 0; i < n; ++i) {
+        least = std::min(least, nb.count(i));
+        most = std::max(most, nb.count(i));
+      }
+      numbers = {double(partition.haloTotal()), partition.imbalance(nb), double(least),
+                 n > 0 ? double(nb.pairCount()) / n : 0.0, double(most)};
     } else {
-      partition.part.assign(static_cast<std::size_t>(nb.particleCount()), 0);
+      partition.part.assign(static_cast<std::size_t>(n), 0);
     }
-    comm.broadcast(partition.part);
-    comm.broadcast(method);
-    if (comm.rank() != 0) completePartition(partition, nb);
+    comm->broadcast(partition.part);
+    comm->broadcast(method);
+    comm->broadcast(numbers);
+    partition.parts = size;
     partition.method = method;
-    comm.setPartition(partition);
-    partition_ = {comm.size(), method, partition.haloTotal(), partition.imbalance(nb)};
-    const auto& owned = partition.owned[comm.rank()];
-    std::vector<std::uint8_t> mine(static_cast<std::size_t>(nb.particleCount()), 0);
+    partition.owned.assign(size, {});
+    partition.halo.assign(size, {});
+    for (Index i = 0; i < n; ++i)
+      partition.owned[partition.part[i]].push_back(i);
+    const auto& own = partition.owned[rank];
+    const NeighbourList mine = buildNeighbourRows<D>(X, own, H, scene.periodicBox);
+    auto& halo = partition.halo[rank];
+    for (Index i : own)
+      for (Index k = mine.offset[i]; k < mine.offset[i + 1]; ++k)
+        if (partition.part[mine.neighbour[k]] != rank) halo.push_back(mine.neighbour[k]);
+    std::sort(halo.begin(), halo.end());
+    halo.erase(std::unique(halo.begin(), halo.end()), halo.end());
+    comm->setPartition(partition, mine);
+    std::merge(own.begin(), own.end(), halo.begin(), halo.end(), std::back_inserter(plan.rows));
+    plan.summary = {size, method, static_cast<Index>(numbers[0]), numbers[1]};
+    plan.neighbours = {static_cast<Index>(numbers[2]), static_cast<Index>(numbers[4]), numbers[3]};
+    return plan;
+  }
+
+  // The pair data: of every particle, or (distributed) of this rank's particles and halo. A
+  // set-up error on one rank (a singular correction tensor in its rows) is every rank's: they
+  // all build the whole configuration then, which throws the serial run's message.
+  static ReferenceConfiguration<D> buildReference(const Scene<D>& scene,
+                                                  const DistributionPlan& plan,
+                                                  Communicator* comm) {
+    auto build = [&](const std::vector<Index>* rows) {
+      return buildReferenceConfiguration<D>(
+          scene.particles.referencePosition, scene.particles.volume, checkedKernel(scene),
+          scene.periodicBox, scene.gradientCorrection, kDefaultMinCorrectionCondition, rows);
+    };
+    if (!plan.active) return build(nullptr);
+    ReferenceConfiguration<D> ref;
+    bool failed = false;
+    try {
+      ref = build(&plan.rows);
+    } catch (const SetupError&) {
+      failed = true;
+    }
+    if (comm->any(failed)) build(nullptr);
+    return ref;
+  }
+
+  // The smallest of the ranks' steps: the lowest index among equal ratios, as serially; the
+  // limiting particle's numbers from its rank.
+  StableStep globalStableStep(const StableStep& mine) const {
+    auto ratioOf = [](const StableStep& s) {
+      return s.particle < 0 ? std::numeric_limits<double>::infinity()
+                            : s.dx / std::sqrt(s.waveSpeed * s.waveSpeed +
+                                               s.hourglassSpeed * s.hourglassSpeed);
+    };
+    double best = -ratioOf(mine);
+    comm_->max(&best, 1);
+    double index = ratioOf(mine) == -best ? -double(mine.particle) : -1e300;
+    comm_->max(&index, 1);
+    const bool limiting = mine.particle == Index(-index);
+    const double none = -std::numeric_limits<double>::infinity();
+    std::array<double, 4> fields = {limiting ? mine.dt : none, limiting ? mine.dx : none,
+                                    limiting ? mine.waveSpeed : none,
+                                    limiting ? mine.hourglassSpeed : none};
+    comm_->max(fields.data(), 4);
+    return {fields[0], Index(-index), fields[1], fields[2], fields[3]};
+  }
+
+  // Keeps this rank's share of each particle list.
+  void distribute() {
+    const auto& owned = plan_.partition.owned[comm_->rank()];
+    std::vector<std::uint8_t> mine(static_cast<std::size_t>(scene_.particles.size()), 0);
     for (Index i : owned)
       mine[i] = 1;
     std::erase_if(ownFree_, [&](Index i) { return !mine[i]; });
     std::erase_if(ownPrescribed_, [&](std::size_t k) { return !mine[prescribed_[k]]; });
     std::erase_if(ownGhosts_, [&](std::size_t k) { return !mine[scene_.mirrorGhosts[k].ghost]; });
     forces_.distribute(owned, comm_);
+  }
+
+  // The quadratic correction's fall-backs over the whole body (each rank knows its own
+  // particles').
+  void summariseFallback() {
+    const auto& list = ref_.linearFallback;
+    if (!comm_) {
+      if (!list.empty())
+        fallback_ = {Index(list.size()), list.front(), ref_.neighbours.count(list.front())};
+      return;
+    }
+    std::vector<std::uint8_t> mine(static_cast<std::size_t>(scene_.particles.size()), 0);
+    for (Index i : *ownedParticles())
+      mine[i] = 1;
+    double count = 0.0, first = -1e300;
+    for (Index i : list)
+      if (mine[i]) {
+        ++count;
+        first = std::max(first, -double(i));
+      }
+    comm_->sum(&count, 1);
+    comm_->max(&first, 1);
+    if (count == 0) return;
+    const Index i = Index(-first);
+    double neighbours = mine[i] ? ref_.neighbours.count(i) : 0.0;
+    comm_->max(&neighbours, 1);
+    fallback_ = {Index(count), i, Index(neighbours)};
   }
 
   // Distributed: the halo's displacements (and, for the artificial viscosity, velocities)
@@ -680,6 +847,7 @@ class Solver {
   }
 
   Scene<D>& scene_;
+  DistributionPlan plan_;
   ReferenceConfiguration<D> ref_;
   TlsphForces<D> forces_;
   std::vector<Index> free_, prescribed_;
@@ -689,7 +857,7 @@ class Solver {
   std::vector<std::size_t> ownPrescribed_, ownGhosts_;
   Communicator* comm_ = nullptr;
   bool synchronized_ = false;
-  PartitionSummary partition_;
+  FallbackSummary fallback_;
   std::vector<double> kineticTerms_;
   std::vector<int> rule_;      // per prescribed particle: index into scene.prescriptions, or -1
   std::vector<Vec<D>> start_;  // per prescribed particle: displacement at the start

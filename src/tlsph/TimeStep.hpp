@@ -35,9 +35,12 @@ struct StableStep {
 };
 
 // hourglassStiffness: K_I per particle, or empty when the penalty is off.
+// candidates: only these particles (ascending; a rank's own, whose stiffness it knows), else
+// all.
 template <int D>
 StableStep stableStep(const ParticleSet<D>& particles, const std::vector<Material>& materials,
-                      double cfl, const std::vector<double>& hourglassStiffness = {}) {
+                      double cfl, const std::vector<double>& hourglassStiffness = {},
+                      const std::vector<Index>* candidates = nullptr) {
   std::vector<double> speed(materials.size());
   for (std::size_t m = 0; m < materials.size(); ++m)
     speed[m] = waveSpeed(materials[m]);
@@ -46,7 +49,9 @@ StableStep stableStep(const ParticleSet<D>& particles, const std::vector<Materia
     anyFree = particles.motion[i] == Motion::Free;
   StableStep best;
   double bestRatio = std::numeric_limits<double>::infinity();
-  for (Index i = 0; i < particles.size(); ++i) {
+  const Index count = candidates ? static_cast<Index>(candidates->size()) : particles.size();
+  for (Index q = 0; q < count; ++q) {
+    const Index i = candidates ? (*candidates)[q] : q;
     if (anyFree && particles.motion[i] != Motion::Free) continue;
     const double dx = std::pow(particles.volume[i], 1.0 / D);
     const double c = speed[particles.material[i]];

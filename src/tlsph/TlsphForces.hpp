@@ -185,10 +185,12 @@ class TlsphForces {
   // The quadrature correction (null unless [kernel] quadrature = taylor).
   const TaylorQuadrature<D>* quadrature() const { return quadrature_.get(); }
 
-  // E_hg of the energy form for the displacements u of the last compute() (0 otherwise).
+  // E_hg of the energy form for the displacements u of the last compute() (0 otherwise);
+  // distributed: a collective, after gatherAll().
   double hourglassEnergy(const std::vector<Vec<D>>& u) const {
     return energyHourglass_
-               ? energyHourglass_->energy(u, separateHourglassGradient_ ? hourglassF_ : F_)
+               ? energyHourglass_->energy(u, separateHourglassGradient_ ? hourglassF_ : F_,
+                                          comm_ ? &owned_ : nullptr, comm_)
                : 0.0;
   }
 

@@ -28,7 +28,7 @@ int check(const std::array<int, D>& counts, const char* name) {
   const auto X = cellCentredLattice<D>(Vec<D>::Zero(), counts, dx);
   const NeighbourList nb = buildNeighbourList<D>(X, 2.1 * dx);
   const DomainPartition partition = partitionParticles<D>(X, nb, size);
-  HaloExchange halo(MPI_COMM_WORLD, partition);
+  HaloExchange halo(MPI_COMM_WORLD, partition, nb);
   const Index n = static_cast<Index>(X.size());
   const double unset = std::numeric_limits<double>::quiet_NaN();
   std::vector<double> scalar(n, unset);
