@@ -12,8 +12,9 @@ output file is compared:
     differ in the last bits: within 1e-12 of the row's largest book;
   - summary.json records the ranks, the same steps and outcome.
 A restart from a checkpoint written on R ranks continues bit for bit, on R ranks and serially;
-a run stopped by SIGTERM on R ranks continues bit for bit with --restart=latest; and a run
-that goes unstable stops at the same step with the same frames. Exit status 0 when all agree.
+a run stopped by SIGTERM on R ranks continues bit for bit with --restart=latest; a set-up
+error stops every rank with the serial message; and a run that goes unstable stops at the
+same step with the same frames. Exit status 0 when all agree.
 Standard library only; run by ctest as mpi_distributed_R.
 """
 import json
@@ -313,6 +314,19 @@ def main():
                         if not p.startswith("summary.json")]
         print(f"SIGTERM on {RANKS} ranks and restart: " +
               ("identical" if not problems else "; ".join(problems)))
+        failures += bool(problems)
+
+        # A set-up error in one rank's particles (a particle without neighbours): every rank
+        # stops with the serial run's message instead of waiting for the others.
+        lone = os.path.join(work, "lone.ini")
+        with open(lone, "w") as f:
+            f.write(SCENES["beam2d"] + "\n[body.stray]\nshape = box\nlower = 1 1\nupper = 1.01 1.01\n")
+        rc1, log1 = run(lone, os.path.join(work, "lone_1"), 0)
+        rcn, logn = run(lone, os.path.join(work, "lone_n"), RANKS)
+        first = lambda log: [l for l in log.splitlines() if "set-up error" in l]
+        problems = [] if rc1 == 1 and rcn == 1 and first(log1) and first(log1) == first(logn) else [
+            f"exit status {rc1} / {rcn}:\n{log1}\n{logn}"]
+        print(f"set-up error on {RANKS} ranks: " + ("same" if not problems else "; ".join(problems)))
         failures += bool(problems)
 
         # An unstable run (a step 3x the rule's): same step, cause and frames.
