@@ -4,7 +4,8 @@
 # at the scene defaults (quadratic correction, Taylor quadrature, energy penalty alpha = 10),
 # one OpenMP thread per rank, ranks 1, 2 and 4 (4 oversubscribed on 2 cores), and one rank on
 # two threads for comparison. Prints one line per run: particles, ranks x threads, wall per
-# step, particle-steps/s, halo exchange and reduction time per step, halo bytes per step.
+# step, particle-steps/s, halo exchange and reduction time per step, halo bytes per step, and
+# the time to gather the whole state for an observation (series row, frame, check).
 # Usage: benchmarks/scaling.sh [strong|weak|all]   (about 15 minutes for all on 2 cores)
 set -u
 cd "$(dirname "$0")/.."
@@ -27,17 +28,16 @@ run() {  # ranks threads steps dx length
   halo=$(grep -o "halo exchanges [0-9.e+-]* ms" <<<"$out" | cut -d' ' -f3)
   red=$(grep -o "reductions [0-9.e+-]* ms" <<<"$out" | cut -d' ' -f2)
   bytes=$(grep -o "([0-9.e+-]* MB received" <<<"$out" | tr -d '(' | cut -d' ' -f1)
-  printf "%9s particles  %d x %d  %8.3f ms/step  %.3g particle-steps/s  halo %s ms  reductions %s ms  %s MB/step\n" \
-    "$n" "$ranks" "$threads" "$(echo "$wall * 1000 / $steps" | bc -l)" "$rate" "${halo:--}" "${red:--}" "${bytes:--}"
+  gather=$(grep -o "observation [0-9.e+-]* ms" <<<"$out" | cut -d' ' -f2)
+  printf "%9s particles  %d x %d  %8.3f ms/step  %.3g particle-steps/s  halo %s ms  reductions %s ms  %s MB/step  gather %s ms\n" \
+    "$n" "$ranks" "$threads" "$(echo "$wall * 1000 / $steps" | bc -l)" "$rate" "${halo:--}" "${red:--}" "${bytes:--}" "${gather:--}"
   [ -n "$rate" ] || echo "$out" | tail -5
 }
 if [ "$what" = strong ] || [ "$what" = all ]; then
   echo "# strong scaling: the same beam (length 1 m) on more ranks"
   for size in "0.01 1000" "0.00464 100" "0.00215 10"; do
     set -- $size
-    run 1 1 "$2" "$1" 1; run 1 2 "$2" "$1" 1; run 2 1 "$2" "$1" 1
-    # 4 ranks hold 4 copies of the reference data (about 8.5 GB each at 10^6 particles)
-    [ "$1" = 0.00215 ] || run 4 1 "$2" "$1" 1
+    run 1 1 "$2" "$1" 1; run 1 2 "$2" "$1" 1; run 2 1 "$2" "$1" 1; run 4 1 "$2" "$1" 1
   done
 fi
 if [ "$what" = weak ] || [ "$what" = all ]; then
