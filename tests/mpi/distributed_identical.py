@@ -235,6 +235,17 @@ def compare(serial, distributed, hourglass_book):
     return problems
 
 
+def continued(serial, distributed):
+    """compare() for a run continued from a checkpoint (its summary.json counts only its part)."""
+    return [p for p in compare(serial, distributed, False) if not p.startswith("summary.json")]
+
+
+def report(what, problems, ok="identical"):
+    """Prints one result line; 1 for a failure."""
+    print(f"{what} on {RANKS} ranks: " + (ok if not problems else "; ".join(problems)))
+    return int(bool(problems))
+
+
 def main():
     work = tempfile.mkdtemp(prefix="tlsph_mpi_")
     failures = 0
@@ -252,8 +263,7 @@ def main():
             if rc1 not in (0, 3):
                 problems.append(f"serial run failed ({rc1}):\n{log1}")
             problems += compare(serial, distributed, "ganzenmueller" in text)
-            print(f"{name}: {RANKS} ranks: " + ("identical" if not problems else "; ".join(problems)))
-            failures += bool(problems)
+            failures += report(name, problems)
 
         # Restart: the checkpoint a run on RANKS ranks wrote at step 60, continued on RANKS
         # ranks (the output rewound to that step), ends where the serial run ends.
@@ -268,10 +278,8 @@ def main():
         problems = [] if os.path.exists(checkpoint) and rc == 0 and rc2 == 0 else [
             f"restart runs failed ({rc}, {rc2}):\n{log}\n{log2}"]
         if not problems:
-            problems = [p for p in compare(os.path.join(work, "block3d_1"), restarted, False)
-                        if not p.startswith("summary.json")]
-        print(f"restart on {RANKS} ranks: " + ("identical" if not problems else "; ".join(problems)))
-        failures += bool(problems)
+            problems = continued(os.path.join(work, "block3d_1"), restarted)
+        failures += report("restart", problems)
 
         # The same checkpoint continued serially: a checkpoint holds the whole state, so the
         # rank count may change at a restart.
@@ -281,11 +289,8 @@ def main():
         rc3, log3 = run(scene, serial_restart, 0, every + ["--restart=" + moved])
         problems = [] if rc3 == 0 and "(step 60," in log3 else [f"serial restart failed:\n{log3}"]
         if not problems:
-            problems = [p for p in compare(os.path.join(work, "block3d_1"), serial_restart, False)
-                        if not p.startswith("summary.json")]
-        print(f"checkpoint of {RANKS} ranks continued serially: " +
-              ("identical" if not problems else "; ".join(problems)))
-        failures += bool(problems)
+            problems = continued(os.path.join(work, "block3d_1"), serial_restart)
+        failures += report("serial continuation of a checkpoint written", problems)
 
         # SIGTERM to mpirun (which passes it on to every rank): all ranks stop at one step,
         # a checkpoint is written, and --restart=latest ends where the serial run ends.
@@ -311,11 +316,8 @@ def main():
         if "stopped by signal 15" not in out or rc2 != 0 or rc1 != 0:
             problems.append(f"stop and restart failed ({rc1}, {rc2}):\n{out}\n{log2}")
         else:
-            problems = [p for p in compare(os.path.join(work, "long_1"), stopped, False)
-                        if not p.startswith("summary.json")]
-        print(f"SIGTERM on {RANKS} ranks and restart: " +
-              ("identical" if not problems else "; ".join(problems)))
-        failures += bool(problems)
+            problems = continued(os.path.join(work, "long_1"), stopped)
+        failures += report("SIGTERM and restart", problems)
 
         # A set-up error in one rank's particles (a particle without neighbours): every rank
         # stops with the serial run's message instead of waiting for the others.
@@ -327,8 +329,7 @@ def main():
         first = lambda log: [l for l in log.splitlines() if "set-up error" in l]
         problems = [] if rc1 == 1 and rcn == 1 and first(log1) and first(log1) == first(logn) else [
             f"exit status {rc1} / {rcn}:\n{log1}\n{logn}"]
-        print(f"set-up error on {RANKS} ranks: " + ("same" if not problems else "; ".join(problems)))
-        failures += bool(problems)
+        failures += report("set-up error", problems, ok="same")
 
         # An unstable run (a step 3x the rule's): same step, cause and frames.
         scene = os.path.join(work, "beam2d.ini")
@@ -346,8 +347,7 @@ def main():
             linen = [l for l in logn.splitlines() if "unstable at step" in l]
             if line1 != linen:
                 problems.append(f"messages differ: {line1} / {linen}")
-        print(f"unstable on {RANKS} ranks: " + ("identical" if not problems else "; ".join(problems)))
-        failures += bool(problems)
+        failures += report("unstable run", problems)
     finally:
         shutil.rmtree(work, ignore_errors=True)
     return 1 if failures else 0
