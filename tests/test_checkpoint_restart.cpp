@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "ProgramRunner.hpp"
+#include "app/OutputDirectory.hpp"
 #include "output/CheckpointArchive.hpp"
 #include "output/CsvSeries.hpp"
 
@@ -356,6 +357,27 @@ TEST_F(CheckpointRestart, OutputDirectoryOfAnEarlierRunNeedsOverwrite) {
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_TRUE(fs::exists(dir_ / "out" / "hourglass_block_000002.vtu"));
   EXPECT_FALSE(fs::exists(dir_ / "out" / "hourglass_block_000020.vtu"));  // stale frame removed
+}
+
+// A distributed run's frames (NAME_NNNNNN.pvtu and the directory of its pieces) mark the
+// directory as holding a run, and --overwrite removes them; other files and directories stay.
+TEST_F(CheckpointRestart, FramesInPiecesAreAnEarlierRunsOutput) {
+  const fs::path out = dir_ / "pieces";
+  fs::create_directories(out / "beam_000001");
+  fs::create_directories(out / "beam_00001x");
+  std::ofstream(out / "beam_000001" / "beam_000001_0.vtu") << "piece";
+  std::ofstream(out / "notes.txt") << "mine";
+  std::ofstream(out / "beam_000001.pvtu") << "index";
+  EXPECT_EQ(tlsph::runOutputFiles(out, "beam"),
+            (std::vector<fs::path>{out / "beam_000001", out / "beam_000001.pvtu"}));
+  EXPECT_THROW(tlsph::prepareOutputDirectory(out, "beam", false, false),
+               tlsph::OutputDirectoryError);
+  EXPECT_TRUE(fs::exists(out / "beam_000001" / "beam_000001_0.vtu"));
+  tlsph::prepareOutputDirectory(out, "beam", true, false);
+  EXPECT_FALSE(fs::exists(out / "beam_000001"));
+  EXPECT_FALSE(fs::exists(out / "beam_000001.pvtu"));
+  EXPECT_TRUE(fs::exists(out / "beam_00001x"));
+  EXPECT_TRUE(fs::exists(out / "notes.txt"));
 }
 
 // The output directory cannot be created: a clear error before anything runs.

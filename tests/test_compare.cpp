@@ -625,6 +625,69 @@ TEST_F(CompareTest, FramesAreFoundFromTheRunDirectory) {
             std::string::npos);
 }
 
+// A distributed run's frame (a .pvtu of per-rank pieces) is found in its run directory and
+// compares as the whole frame: the same particles, ghosts, time and norms.
+TEST_F(CompareTest, FramesInPiecesCompareAsTheWholeFrame) {
+  auto fem = boxMesh({0, 0, 0}, {1.0, 0.5, 0.2}, {7, 4, 3}, 3);
+  addLinearFields(fem, 3);
+  const Lattice l = lattice({20, 10, 4}, 0.05, 3, 2);
+  const Perturbation du = [](std::size_t, const Point& X, double* u) {
+    u[0] += 2e-5 * std::sin(7 * X[0]);
+    u[2] += 1e-5 * std::cos(3 * X[1]);
+  };
+  const Frame whole = latticeFrame(l, 3, du);
+  const Comparison expected = run(fem, whole);
+
+  // Two ranks: the particles split in alternate blocks of 50.
+  VtuSeriesWriter series(dir_ / "run", "beam");
+  std::vector<Frame> pieces(2);
+  for (int r = 0; r < 2; ++r) {
+    Frame& piece = pieces[r];
+    piece.time = whole.time;
+    piece.step = whole.step;
+    piece.ids.emplace();
+    piece.fields = {{"displacement", 3, {}}, {"cauchy_stress", 9, {}}};
+    piece.flags = {{"ghost", {}}, {"body", {}}};
+    for (std::size_t i = 0; i < whole.points.size(); ++i) {
+      if (int(i / 50 % 2) != r) continue;
+      piece.ids->push_back(std::int64_t(i));
+      piece.points.push_back(whole.points[i]);
+      for (std::size_t f = 0; f < 2; ++f) {
+        const int c = whole.fields[f].components;
+        const auto at = whole.fields[f].values.begin() + std::ptrdiff_t(c * i);
+        piece.fields[f].values.insert(piece.fields[f].values.end(), at, at + c);
+        piece.flags[f].values.push_back(whole.flags[f].values[i]);
+      }
+    }
+    series.writePiece(piece, r);
+  }
+  series.addPieces(pieces[0], 2, true);
+  const FrameChoice choice = chooseFrame(dir_ / "run", "");
+  EXPECT_EQ(choice.file, dir_ / "run" / "beam_000000.pvtu");
+  EXPECT_EQ(chooseFrame(choice.file, "").file, choice.file);  // a lone .pvtu frame
+  const ParticleFrame read = readParticleFrame(choice.file);
+  EXPECT_EQ(read.size(), whole.points.size());
+  EXPECT_EQ(read.time, whole.time);
+  EXPECT_EQ(read.step, whole.step);
+  ASSERT_NE(read.field("id"), nullptr);
+
+  CompareRequest request;
+  request.run = dir_ / "run";
+  request.fem = dir_ / "fem.vtu";
+  const Comparison c = compareWithFem(request);
+  EXPECT_EQ(c.ghosts, expected.ghosts);
+  EXPECT_EQ(c.bodyParticles(), expected.bodyParticles());
+  EXPECT_EQ(c.insideCount, expected.insideCount);
+  ASSERT_EQ(c.fields.size(), expected.fields.size());
+  for (std::size_t f = 0; f < c.fields.size(); ++f) {
+    const FieldErrors &a = c.fields[f].errors, &b = expected.fields[f].errors;
+    EXPECT_EQ(a.compared, b.compared) << a.field;
+    EXPECT_NEAR(a.l2Relative, b.l2Relative, 1e-12 * b.l2Relative) << a.field;  // summed in
+    EXPECT_EQ(a.maxAbsolute, b.maxAbsolute) << a.field;                        // another order
+  }
+  EXPECT_GT(errorsOf(c, "displacement").maxAbsolute, 1e-6);
+}
+
 // ---- (6) end to end: `tlsph run`, then `tlsph compare` against an FEM-like mesh ----
 
 namespace {

@@ -15,6 +15,7 @@
 #include <vtkUnstructuredGrid.h>
 #include <vtkXMLDataElement.h>
 #include <vtkXMLDataParser.h>
+#include <vtkXMLPUnstructuredGridReader.h>
 #include <vtkXMLUnstructuredGridReader.h>
 
 #include <cmath>
@@ -29,6 +30,7 @@
 
 #include "output/CsvSeries.hpp"
 #include "output/Frame.hpp"
+#include "output/VtuFile.hpp"
 #include "output/VtuSeriesWriter.hpp"
 
 using namespace tlsph;
@@ -301,6 +303,150 @@ TEST_F(OutputTest, WritesLeaveNoTemporariesAndFailuresNoPartialFiles) {
     EXPECT_EQ(filesIn(series),
               (std::set<std::string>{"beam.pvd", "beam_000000.vtu", "beam_000001.vtu"}));
   }
+}
+
+namespace {
+
+// The points of `whole` in `particles` (ascending), with their ids: one rank's piece.
+Frame pieceOf(const Frame& whole, const std::vector<std::int64_t>& particles) {
+  Frame piece;
+  piece.time = whole.time;
+  piece.step = whole.step;
+  piece.ids = particles;
+  for (const std::int64_t i : particles)
+    piece.points.push_back(whole.points[i]);
+  for (const auto& field : whole.fields) {
+    PointField f{field.name, field.components, {}};
+    for (const std::int64_t i : particles)
+      for (int c = 0; c < field.components; ++c)
+        f.values.push_back(field.values[i * field.components + c]);
+    piece.fields.push_back(f);
+  }
+  for (const auto& flags : whole.flags) {
+    PointFlags f{flags.name, {}};
+    for (const std::int64_t i : particles)
+      f.values.push_back(flags.values[i]);
+    piece.flags.push_back(f);
+  }
+  return piece;
+}
+
+}  // namespace
+
+// A distributed run's frame: one piece per rank and a .pvtu naming them. VTK's parallel reader
+// gives back every point with its id; put in id order they are the whole frame, bit for bit.
+// A rank without points still writes its piece, with every array.
+TEST_F(OutputTest, FramesInPiecesReadBackAsTheWholeFrame) {
+  VtuSeriesWriter writer(dir_ / "series", "beam");
+  const int ranks = 3;
+  std::vector<std::vector<std::int64_t>> owned(ranks);
+  for (int i = 0; i < 40; ++i)
+    owned[i % 7 < 3 ? 0 : 1].push_back(i);  // rank 2 owns nothing
+  std::vector<Frame> wholes;
+  for (int k = 0; k < 2; ++k) {
+    wholes.push_back(makeFrame(k, 40));
+    std::vector<Frame> pieces;
+    for (int r = 0; r < ranks; ++r) {
+      pieces.push_back(pieceOf(wholes.back(), owned[r]));
+      char name[64];
+      std::snprintf(name, sizeof name, "beam_%06d/beam_%06d_%d.vtu", k, k, r);
+      EXPECT_EQ(writer.writePiece(pieces.back(), r), dir_ / "series" / name);
+    }
+    EXPECT_EQ(writer.frameCount(), static_cast<std::size_t>(k));  // not counted before the index
+    EXPECT_EQ(writer.addPieces(pieces[2], ranks, true),
+              dir_ / "series" / ("beam_00000" + std::to_string(k) + ".pvtu"));
+  }
+  EXPECT_EQ(filesIn(dir_ / "series"),
+            (std::set<std::string>{"beam.pvd", "beam_000000", "beam_000000.pvtu", "beam_000001",
+                                   "beam_000001.pvtu"}));
+  const auto dataSets = readPvd(writer.pvdPath());
+  ASSERT_EQ(dataSets.size(), 2u);
+  EXPECT_EQ(dataSets[1].file, "beam_000001.pvtu");
+  EXPECT_EQ(dataSets[1].time, wholes[1].time);
+  const std::string index = readText(dir_ / "series" / "beam_000001.pvtu");
+  EXPECT_NE(index.find("<PDataArray type=\"Int64\" Name=\"id\""), std::string::npos) << index;
+  EXPECT_NE(index.find("<Piece Source=\"beam_000001/beam_000001_2.vtu\"/>"), std::string::npos);
+
+  for (int k = 0; k < 2; ++k) {
+    SCOPED_TRACE(k);
+    vtkNew<vtkXMLPUnstructuredGridReader> reader;
+    reader->SetFileName((dir_ / "series" / dataSets[k].file).c_str());
+    reader->Update();
+    ASSERT_EQ(reader->GetErrorCode(), 0u);
+    vtkUnstructuredGrid* grid = reader->GetOutput();
+    ASSERT_EQ(grid->GetNumberOfPoints(), 40);
+    vtkDataArray* ids = grid->GetPointData()->GetArray("id");
+    ASSERT_NE(ids, nullptr);
+    EXPECT_EQ(ids->GetDataTypeSize(), 8);
+    // Back in particle order, as one frame (the whole frame has no ids).
+    Frame merged;
+    merged.time = grid->GetFieldData()->GetArray("TIME")->GetTuple1(0);
+    merged.step = static_cast<long>(grid->GetFieldData()->GetArray("STEP")->GetTuple1(0));
+    merged.points.resize(40);
+    std::vector<vtkIdType> at(40, -1);
+    for (vtkIdType p = 0; p < 40; ++p) {
+      const auto i = static_cast<vtkIdType>(ids->GetComponent(p, 0));
+      ASSERT_TRUE(i >= 0 && i < 40 && at[i] < 0) << "id " << i;
+      at[i] = p;
+      grid->GetPoint(p, merged.points[i].data());
+    }
+    EXPECT_EQ(merged.points, wholes[k].points);
+    EXPECT_EQ(merged.time, wholes[k].time);
+    EXPECT_EQ(merged.step, wholes[k].step);
+    for (const auto& field : wholes[k].fields) {
+      vtkDataArray* array = grid->GetPointData()->GetArray(field.name.c_str());
+      ASSERT_NE(array, nullptr) << field.name;
+      for (int i = 0; i < 40; ++i)
+        for (int c = 0; c < field.components; ++c)
+          ASSERT_EQ(array->GetComponent(at[i], c), field.values[i * field.components + c])
+              << field.name;
+    }
+    for (const auto& flags : wholes[k].flags) {
+      auto* array =
+          vtkUnsignedCharArray::SafeDownCast(grid->GetPointData()->GetArray(flags.name.c_str()));
+      ASSERT_NE(array, nullptr) << flags.name;
+      for (int i = 0; i < 40; ++i)
+        ASSERT_EQ(array->GetValue(at[i]), flags.values[i]) << flags.name;
+    }
+  }
+
+  // A piece's ids must match its points.
+  Frame bad = pieceOf(wholes[0], owned[0]);
+  bad.ids->pop_back();
+  EXPECT_THROW(writeVtuFile(bad, dir_ / "bad.vtu"), std::invalid_argument);
+}
+
+// A restart keeps the frames up to its checkpoint: the owner of the index files removes the
+// later ones, whole frames, indices and piece directories alike; other ranks remove nothing.
+TEST_F(OutputTest, ResumeRemovesLaterFramesOfEveryKind) {
+  const fs::path series = dir_ / "series";
+  std::vector<PvdEntry> firstTwo;
+  {
+    VtuSeriesWriter writer(series, "beam");
+    writer.write(makeFrame(0, 6));
+    for (int k = 1; k < 3; ++k) {
+      const Frame piece = pieceOf(makeFrame(k, 6), {0, 1, 2, 3, 4, 5});
+      writer.writePiece(piece, 0);
+      writer.addPieces(piece, 1, true);
+      if (k == 1) firstTwo = writer.frames();
+    }
+    writer.write(makeFrame(3, 6));
+    writer.writePiece(pieceOf(makeFrame(4, 6), {0}), 0);  // stopped before its index
+  }
+  const std::set<std::string> all = {"beam.pvd",         "beam_000000.vtu", "beam_000001",
+                                     "beam_000001.pvtu", "beam_000002",     "beam_000002.pvtu",
+                                     "beam_000003.vtu",  "beam_000004"};
+  ASSERT_EQ(filesIn(series), all);
+  VtuSeriesWriter other(series, "beam");
+  other.resume(firstTwo, false);
+  EXPECT_EQ(filesIn(series), all);
+  EXPECT_EQ(other.frameCount(), 2u);
+  VtuSeriesWriter owner(series, "beam");
+  owner.resume(firstTwo, true);
+  EXPECT_EQ(filesIn(series), (std::set<std::string>{"beam.pvd", "beam_000000.vtu", "beam_000001",
+                                                    "beam_000001.pvtu"}));
+  EXPECT_EQ(readPvd(owner.pvdPath()).size(), 2u);
+  EXPECT_EQ(owner.write(makeFrame(2, 6)), series / "beam_000002.vtu");
 }
 
 TEST_F(OutputTest, CsvSeriesRoundTripsAndRewrites) {

@@ -28,7 +28,7 @@ class Alone final : public Communicator {
   void gatherAllBytes(char*, std::size_t) override {}
   void sum(double*, int) override {}
   void max(double*, int) override {}
-  void broadcastBytes(char*, std::size_t) override {}
+  void broadcastBytes(char*, std::size_t, int) override {}
   void barrier() override {}
 };
 

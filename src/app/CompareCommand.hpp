@@ -21,7 +21,7 @@ inline constexpr const char* kCompareUsage =
 Compares a tlsph frame with an FEM solution, field by field, at the particles' reference
 positions (docs/compare.md).
 
-  RUN    a tlsph output directory, its .pvd series, or one .vtu frame
+  RUN    a tlsph output directory, its .pvd series, or one .vtu (.pvtu) frame
   FEM    the FEM solution on the undeformed mesh: VTK XML (.vtu) or legacy (.vtk)
          unstructured grid with point (or cell) arrays displacement [m] and, optionally,
          cauchy_stress [Pa] (9 components row-major, or 6: xx yy zz xy yz xz)

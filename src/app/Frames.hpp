@@ -62,43 +62,61 @@ inline const std::vector<std::string>& allFrameFields() {
   return names;
 }
 
-// The hourglass_error field of every particle when `fields` asks for it (else empty). A
-// distributed rank keeps pair data for its own particles only: each computes theirs and the
-// field is gathered, so every rank calls this (after Solver::synchronize()).
+// The hourglass_error field when `fields` asks for it (else empty), one value per particle.
+// A distributed rank keeps pair data for its own particles only: each computes theirs, and
+// with `whole` the field is gathered, so every rank calls this (after Solver::synchronize());
+// without, only the rank's own values are set (for its piece of a frame).
 template <int D>
 std::vector<double> hourglassErrorField(const SceneSetup<D>& setup, const Solver<D>& solver,
-                                        const std::vector<std::string>& fields) {
+                                        const std::vector<std::string>& fields, bool whole = true) {
   if (std::find(fields.begin(), fields.end(), "hourglass_error") == fields.end()) return {};
   std::vector<double> out =
       hourglassError<D>(solver.reference(), setup.scene.particles.displacement,
                         solver.forces().deformationGradient(), solver.ownedParticles());
-  if (Communicator* comm = solver.communicator()) comm->gatherAll(out);
+  if (Communicator* comm = solver.communicator(); comm && whole) comm->gatherAll(out);
   return out;
 }
 
-// hourglassError: the field from hourglassErrorField (computed here when null).
+// The frame of every particle, or with `piece` of those particles only (ascending), each point
+// carrying its particle number (Frame::ids): a distributed rank's piece. hourglassError: the
+// field from hourglassErrorField (computed here when null).
 template <int D>
 Frame makeFrame(const SceneSetup<D>& setup, const Solver<D>& solver,
                 const std::vector<std::string>& fields,
-                const std::vector<double>* hourglassErrorValues = nullptr) {
+                const std::vector<double>* hourglassErrorValues = nullptr,
+                const std::vector<Index>* piece = nullptr) {
   const auto& p = setup.scene.particles;
-  const Index n = p.size();
+  const Index n = piece ? static_cast<Index>(piece->size()) : p.size();
+  auto particle = [&](Index k) { return piece ? (*piece)[k] : k; };
   Frame frame;
   frame.time = solver.time();
   frame.step = solver.stepCount();
   frame.points.resize(n);
-  for (Index i = 0; i < n; ++i) {
-    frame.points[i] = {0.0, 0.0, 0.0};
-    const Vec<D> x = p.currentPosition(i);
+  for (Index k = 0; k < n; ++k) {
+    frame.points[k] = {0.0, 0.0, 0.0};
+    const Vec<D> x = p.currentPosition(particle(k));
     for (int a = 0; a < D; ++a)
-      frame.points[i][a] = x[a];
+      frame.points[k][a] = x[a];
   }
+  if (piece) frame.ids.emplace(piece->begin(), piece->end());
+  auto scalarField = [&](const std::string& name, auto&& value) {
+    PointField f{name, 1, std::vector<double>(n)};
+    for (Index k = 0; k < n; ++k)
+      f.values[k] = value(particle(k));
+    frame.fields.push_back(std::move(f));
+  };
   auto vectorField = [&](const std::string& name, const std::vector<Vec<D>>& v) {
     PointField f{name, 3, std::vector<double>(3 * n, 0.0)};
-    for (Index i = 0; i < n; ++i)
+    for (Index k = 0; k < n; ++k)
       for (int a = 0; a < D; ++a)
-        f.values[3 * i + a] = v[i][a];
+        f.values[3 * k + a] = v[particle(k)][a];
     frame.fields.push_back(std::move(f));
+  };
+  auto flagField = [&](const std::string& name, auto&& value) {
+    PointFlags f{name, std::vector<std::uint8_t>(n)};
+    for (Index k = 0; k < n; ++k)
+      f.values[k] = value(particle(k));
+    frame.flags.push_back(std::move(f));
   };
   const auto& F = solver.forces().deformationGradient();
   for (const auto& name : fields) {
@@ -107,39 +125,34 @@ Frame makeFrame(const SceneSetup<D>& setup, const Solver<D>& solver,
     } else if (name == "velocity") {
       vectorField(name, p.velocity);
     } else if (name == "J") {
-      PointField f{name, 1, std::vector<double>(n)};
-      for (Index i = 0; i < n; ++i)
-        f.values[i] = F[i].determinant();
-      frame.fields.push_back(std::move(f));
-    } else if (name == "first_piola" || name == "cauchy_stress" || name == "von_mises") {
-      PointField f{name, name == "von_mises" ? 1 : 9, {}};
-      f.values.resize(f.components * n);
-      for (Index i = 0; i < n; ++i) {
+      scalarField(name, [&](Index i) { return F[i].determinant(); });
+    } else if (name == "von_mises") {
+      scalarField(name, [&](Index i) {
+        const Mat3 sigma = cauchyStressOf(setup, F[i], i);
+        const Mat3 dev = sigma - sigma.trace() / 3.0 * Mat3::Identity();
+        return std::sqrt(1.5 * dev.squaredNorm());
+      });
+    } else if (name == "first_piola" || name == "cauchy_stress") {
+      PointField f{name, 9, std::vector<double>(9 * n)};
+      for (Index k = 0; k < n; ++k) {
+        const Index i = particle(k);
         const Mat3 out =
             name == "first_piola" ? firstPiolaOf(setup, F[i], i) : cauchyStressOf(setup, F[i], i);
-        if (name == "von_mises") {
-          const Mat3 dev = out - out.trace() / 3.0 * Mat3::Identity();
-          f.values[i] = std::sqrt(1.5 * dev.squaredNorm());
-        } else {
-          for (int r = 0; r < 3; ++r)
-            for (int c = 0; c < 3; ++c)
-              f.values[9 * i + 3 * r + c] = out(r, c);
-        }
+        for (int r = 0; r < 3; ++r)
+          for (int c = 0; c < 3; ++c)
+            f.values[9 * k + 3 * r + c] = out(r, c);
       }
       frame.fields.push_back(std::move(f));
     } else if (name == "hourglass_error") {
-      frame.fields.push_back(
-          PointField{name, 1,
-                     hourglassErrorValues && !hourglassErrorValues->empty()
-                         ? *hourglassErrorValues
-                         : hourglassError<D>(solver.reference(), p.displacement, F)});
+      const bool given = hourglassErrorValues && !hourglassErrorValues->empty();
+      const std::vector<double> computed =
+          given ? std::vector<double>() : hourglassError<D>(solver.reference(), p.displacement, F);
+      const std::vector<double>& values = given ? *hourglassErrorValues : computed;
+      scalarField(name, [&](Index i) { return values[i]; });
     } else if (name == "flags") {
-      frame.flags.push_back(PointFlags{"ghost", setup.ghost});
-      std::vector<std::uint8_t> prescribed(n);
-      for (Index i = 0; i < n; ++i)
-        prescribed[i] = p.motion[i] == Motion::Prescribed;
-      frame.flags.push_back(PointFlags{"prescribed", prescribed});
-      frame.flags.push_back(PointFlags{"body", setup.body});
+      flagField("ghost", [&](Index i) { return setup.ghost[i]; });
+      flagField("prescribed", [&](Index i) { return p.motion[i] == Motion::Prescribed; });
+      flagField("body", [&](Index i) { return setup.body[i]; });
     }
   }
   return frame;

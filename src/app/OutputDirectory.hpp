@@ -93,27 +93,31 @@ inline std::string byteText(double bytes) {
   return text;
 }
 
-// Files of a run named `name` in its output directory: what --overwrite removes, and what
-// marks the directory as holding a run.
+// Files of a run named `name` in its output directory (and directories of frame pieces):
+// what --overwrite removes, and what marks the directory as holding a run.
 inline std::vector<std::filesystem::path> runOutputFiles(const std::filesystem::path& dir,
                                                          const std::string& name) {
   namespace fs = std::filesystem;
   std::vector<fs::path> files;
   std::error_code status;
   if (!fs::is_directory(dir, status)) return files;
-  auto isFrame = [&](const std::string& f) {  // NAME_NNNNNN.vtu
+  // NAME_NNNNNN + suffix: a frame (.vtu), a distributed frame's index (.pvtu) or the
+  // directory of its pieces ("").
+  auto isFrame = [&](const std::string& f, const std::string& suffix) {
     const std::size_t stem = name.size() + 1;
-    if (f.size() != stem + 10 || f.compare(0, stem, name + "_") != 0 ||
-        f.compare(stem + 6, 4, ".vtu") != 0)
+    if (f.size() != stem + 6 + suffix.size() || f.compare(0, stem, name + "_") != 0 ||
+        f.compare(stem + 6, suffix.size(), suffix) != 0)
       return false;
     return std::all_of(f.begin() + stem, f.begin() + stem + 6,
                        [](char c) { return c >= '0' && c <= '9'; });
   };
   for (const auto& entry : fs::directory_iterator(dir, status)) {
     const std::string f = entry.path().filename().string();
-    if (f == "summary.json" || f == "energies.csv" || f == "probes.csv" || f == "reactions.csv" ||
-        f == name + ".pvd" || f == name + "_last_good.vtu" || f == name + "_failed.vtu" ||
-        isFrame(f))
+    if (entry.is_directory(status)
+            ? isFrame(f, "")
+            : f == "summary.json" || f == "energies.csv" || f == "probes.csv" ||
+                  f == "reactions.csv" || f == name + ".pvd" || f == name + "_last_good.vtu" ||
+                  f == name + "_failed.vtu" || isFrame(f, ".vtu") || isFrame(f, ".pvtu"))
       files.push_back(entry.path());
   }
   const fs::path checkpoints = dir / "checkpoints";
@@ -160,7 +164,7 @@ inline void prepareOutputDirectory(const std::filesystem::path& dir, const std::
         "): pass --overwrite to replace it, --restart=latest to continue that run, or set "
         "another [output] directory");
   for (const auto& f : earlier)
-    fs::remove(f, error);
+    fs::remove_all(f, error);  // a distributed frame's pieces are a directory
 }
 
 // Refuses a run whose planned output does not fit the free space of its file system.

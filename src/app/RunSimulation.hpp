@@ -144,8 +144,9 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
   const OutputSettings& out = setup.output;
   const fs::path dir = out.directory;
 
-  std::unique_ptr<VtuSeriesWriter> vtu;  // rank 0's
-  if (!out.fields.empty() && root) vtu = std::make_unique<VtuSeriesWriter>(dir, setup.name);
+  // Serially one .vtu per frame; distributed, each rank writes its piece and rank 0 the index.
+  std::unique_ptr<VtuSeriesWriter> vtu;
+  if (!out.fields.empty()) vtu = std::make_unique<VtuSeriesWriter>(dir, setup.name);
   const std::vector<std::string> preamble = {
       "tlsph scene " + setup.name + " from " + setup.sourceFile, "command: " + options.command,
       "SI units: s, m, J, kg m/s"};
@@ -219,6 +220,16 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
     if (comm) comm->broadcast(failure);
     if (!failure.empty()) throw OutputWriteFailure(failure);
   };
+  // A write on every rank (its piece of a frame): the lowest failing rank's reason stops all.
+  auto writingOnEveryRank = [&](auto&& write) {
+    std::string failure;
+    try {
+      write();
+    } catch (const std::exception& e) {
+      failure = "rank " + std::to_string(comm->rank()) + ": " + e.what();
+    }
+    if (comm->firstNonEmpty(failure) >= 0) throw OutputWriteFailure(failure);
+  };
   auto flushSeries = [&] {
     writing([&] {
       energies.flush();
@@ -231,8 +242,18 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
   auto writeFrame = [&] {
     solver.synchronize();
     if (!out.fields.empty() && lastFrameStep != solver.stepCount()) {
-      const auto hourglassError = hourglassErrorField(setup, solver, setup.output.fields);
-      writing([&] { vtu->write(makeFrame(setup, solver, setup.output.fields, &hourglassError)); });
+      const auto& fields = setup.output.fields;
+      if (!comm) {
+        const auto hourglassError = hourglassErrorField(setup, solver, fields);
+        writing([&] { vtu->write(makeFrame(setup, solver, fields, &hourglassError)); });
+      } else {
+        const auto hourglassError = hourglassErrorField(setup, solver, fields, false);
+        const Frame piece =
+            makeFrame(setup, solver, fields, &hourglassError, solver.ownedParticles());
+        writingOnEveryRank([&] { vtu->writePiece(piece, comm->rank()); });
+        writing([&] { vtu->addPieces(piece, comm->size(), true); });
+        if (!root) vtu->addPieces(piece, comm->size(), false);  // counts it
+      }
     }
     lastFrameStep = solver.stepCount();
     flushSeries();
@@ -249,11 +270,12 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
     energies.resume(o.energyRows);
     if (probes) probes->resume(o.probeRows);
     if (reactions) reactions->resume(o.reactionRows);
-    if (vtu) vtu->resume(o.frames);
+    if (vtu) vtu->resume(o.frames, root);
     lastFrameStep = o.lastFrameStep;
     nextFrameTime = o.nextFrameTime;
     guard.resume(resume->guard);
     summary.restartedAtStep = resume->solver.steps;
+    if (comm) comm->barrier();  // rank 0 has removed later frames before any rank writes one
   }
 
   CheckpointSchedule schedule(dir, setup.name, setup.checkpoint);

@@ -4,12 +4,15 @@
 #include <vtkFieldData.h>
 #include <vtkNew.h>
 #include <vtkPointData.h>
+#include <vtkSmartPointer.h>
 #include <vtkUnstructuredGrid.h>
+#include <vtkXMLPUnstructuredGridReader.h>
 #include <vtkXMLUnstructuredGridReader.h>
 
 #include <stdexcept>
 #include <string>
 
+#include "compare/RunFrame.hpp"
 #include "compare/VtkErrorLog.hpp"
 
 namespace tlsph {
@@ -25,14 +28,22 @@ const PointField* ParticleFrame::field(std::string_view name) const {
 ParticleFrame readParticleFrame(const fs::path& file) {
   if (!fs::is_regular_file(file))
     throw std::runtime_error("tlsph frame " + file.string() + " does not exist");
-  vtkNew<vtkXMLUnstructuredGridReader> reader;
+  // A distributed run's frame is an index (.pvtu) of per-rank pieces: VTK's reader appends
+  // them in piece order.
+  vtkSmartPointer<vtkXMLReader> reader;
+  if (lowerExtension(file) == ".pvtu")
+    reader = vtkSmartPointer<vtkXMLPUnstructuredGridReader>::New();
+  else
+    reader = vtkSmartPointer<vtkXMLUnstructuredGridReader>::New();
   VtkErrorLog errors(reader);
   reader->SetFileName(file.c_str());
   reader->Update();
   if (!errors.empty() || reader->GetErrorCode() != 0)
     throw std::runtime_error("cannot read tlsph frame " + file.string() + ": " +
                              (errors.empty() ? "VTK reader failed" : errors.text()));
-  vtkUnstructuredGrid* grid = reader->GetOutput();
+  vtkUnstructuredGrid* grid = vtkUnstructuredGrid::SafeDownCast(reader->GetOutputDataObject(0));
+  if (!grid)
+    throw std::runtime_error("tlsph frame " + file.string() + " is not an unstructured grid");
   const vtkIdType n = grid->GetNumberOfPoints();
   if (n == 0) throw std::runtime_error("tlsph frame " + file.string() + " has no particles");
 

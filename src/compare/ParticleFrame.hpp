@@ -1,5 +1,6 @@
-// A tlsph output frame (.vtu) read back for comparison: the particles' reference positions
-// X = x - u, which of them are ghosts, and the point fields as written.
+// A tlsph output frame (.vtu, or a distributed run's .pvtu of pieces) read back for comparison: the
+// particles' reference positions X = x - u, which of them are ghosts, and the point fields as
+// written.
 #pragma once
 
 #include <array>
@@ -27,9 +28,10 @@ struct ParticleFrame {
   const PointField* field(std::string_view name) const;
 };
 
-// Reads a frame written by `tlsph run` (any VTK XML unstructured grid with a 3-component point
-// array `displacement`). Throws std::runtime_error naming the file and, for a missing or
-// malformed displacement, what to add to the scene's [output] fields.
+// Reads a frame written by `tlsph run` (any VTK XML unstructured grid, .vtu or .pvtu, with a
+// 3-component point array `displacement`; a .pvtu's pieces in piece order). Throws
+// std::runtime_error naming the file and, for a missing or malformed displacement, what to add to
+// the scene's [output] fields.
 ParticleFrame readParticleFrame(const std::filesystem::path& file);
 
 }  // namespace tlsph

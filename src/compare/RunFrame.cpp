@@ -16,14 +16,14 @@ namespace tlsph {
 
 namespace fs = std::filesystem;
 
-namespace {
-
 std::string lowerExtension(const fs::path& path) {
   std::string ext = path.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return ext;
 }
+
+namespace {
 
 // The string value of `key` in a flat JSON object such as summary.json; "" if absent.
 std::string jsonStringValue(const std::string& text, const std::string& key) {
@@ -119,12 +119,12 @@ std::vector<PvdEntry> readPvdFile(const fs::path& pvd) {
 FrameChoice chooseFrame(const fs::path& run, const std::string& frame) {
   if (!fs::exists(run))
     throw std::runtime_error(run.string() +
-                             " does not exist; expected a tlsph output directory, a .pvd or a "
-                             ".vtu file");
+                             " does not exist; expected a tlsph output directory, a .pvd, or a "
+                             ".vtu or .pvtu frame");
   fs::path series = run;
   if (fs::is_directory(run)) {
     series = seriesOfDirectory(run);
-  } else if (lowerExtension(run) == ".vtu") {
+  } else if (lowerExtension(run) == ".vtu" || lowerExtension(run) == ".pvtu") {
     if (!frame.empty() && frame != "last")
       throw std::runtime_error("--frame " + frame + " selects a frame of a .pvd series, but " +
                                run.string() + " is a single frame");
@@ -133,7 +133,8 @@ FrameChoice chooseFrame(const fs::path& run, const std::string& frame) {
     return choice;
   } else if (lowerExtension(run) != ".pvd") {
     throw std::runtime_error(run.string() +
-                             ": expected a tlsph output directory, a .pvd or a .vtu file");
+                             ": expected a tlsph output directory, a .pvd, or a .vtu or .pvtu "
+                             "frame");
   }
 
   const std::vector<PvdEntry> entries = readPvdFile(series);

@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,10 @@ struct Frame {
   std::vector<std::array<double, 3>> points;  // current positions (2D: z = 0)
   std::vector<PointField> fields;
   std::vector<PointFlags> flags;
+  // Written as the Int64 point array `id` when present: each point's particle number in the
+  // whole body, for a piece of a distributed run's frame (in a whole frame point k is
+  // particle k). Present and empty for a piece without points, so every piece has the array.
+  std::optional<std::vector<std::int64_t>> ids;
 };
 
 }  // namespace tlsph

@@ -7,36 +7,9 @@
 
 #include "output/AtomicFile.hpp"
 #include "output/RoundTripNumber.hpp"
+#include "output/XmlText.hpp"
 
 namespace tlsph {
-
-namespace {
-
-// File names come from user-chosen scene names, so they may hold XML specials.
-std::string xmlAttribute(const std::string& text) {
-  std::string out;
-  for (const char c : text) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
-
-}  // namespace
 
 void writePvdFile(const std::filesystem::path& pvd, const std::vector<PvdEntry>& entries) {
   std::string text = "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" ";

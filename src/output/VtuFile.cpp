@@ -54,6 +54,12 @@ void checkFrame(const Frame& frame, const std::filesystem::path& file) {
                                   std::to_string(flags.values.size()) + " values for " +
                                   std::to_string(n) + " points" + where);
   }
+  if (frame.ids) {
+    checkName("id");
+    if (frame.ids->size() != n)
+      throw std::invalid_argument("ids: " + std::to_string(frame.ids->size()) + " values for " +
+                                  std::to_string(n) + " points" + where);
+  }
 }
 
 vtkNew<vtkUnstructuredGrid> makeGrid(const Frame& frame) {
@@ -95,6 +101,14 @@ vtkNew<vtkUnstructuredGrid> makeGrid(const Frame& frame) {
     array->SetNumberOfTuples(n);
     std::copy(flags.values.begin(), flags.values.end(), array->GetPointer(0));
     grid->GetPointData()->AddArray(array);
+  }
+
+  if (frame.ids) {
+    vtkNew<vtkTypeInt64Array> ids;
+    ids->SetName("id");
+    ids->SetNumberOfTuples(n);
+    std::copy(frame.ids->begin(), frame.ids->end(), ids->GetPointer(0));
+    grid->GetPointData()->AddArray(ids);
   }
 
   vtkNew<vtkDoubleArray> time;

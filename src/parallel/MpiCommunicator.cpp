@@ -78,8 +78,8 @@ void MpiCommunicator::max(double* values, int count) {
   MPI_Allreduce(MPI_IN_PLACE, values, count, MPI_DOUBLE, MPI_MAX, comm_);
 }
 
-void MpiCommunicator::broadcastBytes(char* data, std::size_t bytes) {
-  MPI_Bcast(data, static_cast<int>(bytes), MPI_BYTE, 0, comm_);
+void MpiCommunicator::broadcastBytes(char* data, std::size_t bytes, int root) {
+  MPI_Bcast(data, static_cast<int>(bytes), MPI_BYTE, root, comm_);
 }
 
 void MpiCommunicator::barrier() {

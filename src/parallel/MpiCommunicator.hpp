@@ -24,7 +24,7 @@ class MpiCommunicator final : public Communicator {
   void gatherAllBytes(char* values, std::size_t width) override;
   void sum(double* values, int count) override;
   void max(double* values, int count) override;
-  void broadcastBytes(char* data, std::size_t bytes) override;
+  void broadcastBytes(char* data, std::size_t bytes, int root) override;
   void barrier() override;
 
   // Particles received per halo exchange on this rank.

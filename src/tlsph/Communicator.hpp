@@ -34,7 +34,7 @@ class Communicator {
 
   virtual void sum(double* values, int count) = 0;  // every rank gets the sums (rank order)
   virtual void max(double* values, int count) = 0;  // every rank gets the maxima
-  virtual void broadcastBytes(char* data, std::size_t bytes) = 0;  // from rank 0
+  virtual void broadcastBytes(char* data, std::size_t bytes, int root) = 0;  // root's bytes
   virtual void barrier() = 0;
 
   // Entries of the halo: set to the owners' values; other entries are left as they were.
@@ -49,18 +49,28 @@ class Communicator {
     static_assert(std::is_trivially_destructible_v<T>);  // plain numbers, Eigen fixed-size
     if (!values.empty()) gatherAllBytes(reinterpret_cast<char*>(values.data()), sizeof(T));
   }
+  // Rank `root`'s values on every rank (the same size on every rank).
   template <class T>
-  void broadcast(std::vector<T>& values) {
+  void broadcast(std::vector<T>& values, int root = 0) {
     static_assert(std::is_trivially_destructible_v<T>);  // plain numbers, Eigen fixed-size
     if (!values.empty())
-      broadcastBytes(reinterpret_cast<char*>(values.data()), values.size() * sizeof(T));
+      broadcastBytes(reinterpret_cast<char*>(values.data()), values.size() * sizeof(T), root);
   }
-  // Rank 0's string on every rank.
-  void broadcast(std::string& text) {
+  // Rank `root`'s string on every rank.
+  void broadcast(std::string& text, int root = 0) {
     std::vector<long> length = {static_cast<long>(text.size())};
-    broadcast(length);
+    broadcast(length, root);
     text.resize(static_cast<std::size_t>(length[0]));
-    if (length[0] > 0) broadcastBytes(text.data(), text.size());
+    if (length[0] > 0) broadcastBytes(text.data(), text.size(), root);
+  }
+  // The lowest rank with a non-empty `text` (-1 if none); its text on every rank.
+  int firstNonEmpty(std::string& text) {
+    double first = text.empty() ? -1e300 : -double(rank());
+    max(&first, 1);
+    if (first < -1e299) return -1;
+    const int from = int(-first);
+    broadcast(text, from);
+    return from;
   }
   // True on every rank when `flag` is true on some rank.
   bool any(bool flag) {

@@ -6,19 +6,25 @@ prescribed rotation, loads, gravity, probes, kinetic damping with the static sto
 viscosity, the textbook and energy hourglass forms, the Taylor quadrature and the nodal one),
 `tlsph run` is run serially and under `mpirun -np R` (R given on the command line), and every
 output file is compared:
-  - the VTU frames and probes.csv / reactions.csv: byte for byte (comment lines aside);
+  - the VTU frames: serially one .vtu per frame, on R > 1 ranks a .pvtu naming one piece per
+    rank (NAME_NNNNNN/NAME_NNNNNN_R.vtu): the same points and arrays bit for bit, in particle
+    order (through frame_dump), and the .pvd the same but for the extension; no frame files
+    left that the .pvd does not list;
+  - probes.csv / reactions.csv: byte for byte (comment lines aside);
   - energies.csv: byte for byte except the work books (external_work, boundary_work, damped,
     total, and hourglass for the textbook form), which are sums over the ranks' parts and may
     differ in the last bits: within 1e-12 of the row's largest book;
   - summary.json records the ranks, the same steps and outcome.
 A restart from a checkpoint written on R ranks continues bit for bit, on R ranks and serially;
 a run stopped by SIGTERM on R ranks continues bit for bit with --restart=latest; a set-up
-error stops every rank with the serial message; and a run that goes unstable stops at the
+error stops every rank with the serial message; a piece of a frame that cannot be written
+stops every rank (exit 6) with that rank's reason; and a run that goes unstable stops at the
 same step with the same frames. Exit status 0 when all agree.
 Standard library only; run by ctest as mpi_distributed_R.
 """
 import json
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -26,7 +32,7 @@ import sys
 import tempfile
 import time
 
-PROGRAM, MPIEXEC, RANKS = sys.argv[1], sys.argv[2], int(sys.argv[3])
+PROGRAM, MPIEXEC, RANKS, FRAME_DUMP = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4]
 ENV = dict(os.environ, OMP_NUM_THREADS="1", OMPI_ALLOW_RUN_AS_ROOT="1",
            OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMPI_MCA_btl_vader_single_copy_mechanism="none")
 
@@ -208,12 +214,53 @@ def compare_energies(a, b, books):
     return None
 
 
-def compare(serial, distributed, hourglass_book):
+def dump(frame):
+    result = subprocess.run([FRAME_DUMP, frame], capture_output=True, text=True)
+    return result.stdout if result.returncode == 0 else "unreadable: " + result.stderr
+
+
+def frames_listed(directory):
+    """Problems with the frame files of a run: a listed frame without its files (a .pvtu
+    without all its pieces), or frame files the .pvd does not list."""
+    pvds = [n for n in os.listdir(directory) if n.endswith(".pvd")]
+    if len(pvds) != 1:
+        return []
+    stem = pvds[0][:-4]
+    listed = re.findall(r'file="([^"]+)"', open(os.path.join(directory, pvds[0])).read())
+    expected = set(listed) | {f[:-5] for f in listed if f.endswith(".pvtu")}
     problems = []
+    if RANKS > 1 and not any(f.endswith(".pvtu") for f in listed):
+        problems.append("no frame written in pieces")
+    for name in listed:
+        if name.endswith(".pvtu"):
+            pieces = re.findall(r'Source="([^"]+)"', open(os.path.join(directory, name)).read())
+            if len(pieces) != RANKS and RANKS > 1 or not all(
+                    os.path.exists(os.path.join(directory, p)) for p in pieces):
+                problems.append(f"{name}: pieces {pieces}")
+    frame = re.escape(stem) + r"_\d{6}(\.p?vtu)?"
+    present = {n for n in os.listdir(directory) if re.fullmatch(frame, n)}
+    if present != expected:
+        problems.append(f"frame files {sorted(present ^ expected)} not as the .pvd lists")
+    return problems
+
+
+def compare(serial, distributed, hourglass_book):
+    problems = frames_listed(distributed)
     names = sorted(n for n in os.listdir(serial) if os.path.isfile(os.path.join(serial, n)))
     for name in names:
         a, b = os.path.join(serial, name), os.path.join(distributed, name)
-        if not os.path.exists(b):
+        if re.fullmatch(r".*_\d{6}\.vtu", name) and not os.path.exists(b):
+            pieces = b[:-4] + ".pvtu"
+            if not os.path.exists(pieces):
+                problems.append(name + " missing (neither .vtu nor .pvtu)")
+            elif dump(a) != dump(pieces):
+                problems.append(name + " differs from " + os.path.basename(pieces))
+        elif name.endswith(".pvd"):
+            same = os.path.exists(b) and (
+                open(a).read() == open(b).read().replace('.pvtu"', '.vtu"'))
+            if not same:
+                problems.append(name + " differs (or missing)")
+        elif not os.path.exists(b):
             problems.append(name + " missing")
         elif name == "summary.json":
             sa, sb = json.load(open(a)), json.load(open(b))
@@ -330,6 +377,18 @@ def main():
         problems = [] if rc1 == 1 and rcn == 1 and first(log1) and first(log1) == first(logn) else [
             f"exit status {rc1} / {rcn}:\n{log1}\n{logn}"]
         failures += report("set-up error", problems, ok="same")
+
+        # Pieces that cannot be written (a file where the first frame's directory of pieces
+        # goes): every rank stops with exit 6 and the lowest failing rank's reason.
+        if RANKS > 1:
+            blocked = os.path.join(work, "blocked_n")
+            os.makedirs(blocked)
+            open(os.path.join(blocked, "block3d_000000"), "w").write("in the way")
+            rc, log = run(os.path.join(work, "block3d.ini"), blocked, RANKS)
+            piece = os.path.join(blocked, "block3d_000000", "block3d_000000_0.vtu")
+            problems = [] if rc == 6 and "rank 0: cannot write VTU file " + piece in log else [
+                f"exit status {rc}:\n{log}"]
+            failures += report("failed piece write", problems, ok="stopped every rank")
 
         # An unstable run (a step 3x the rule's): same step, cause and frames.
         scene = os.path.join(work, "beam2d.ini")
