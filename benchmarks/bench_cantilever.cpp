@@ -1,14 +1,19 @@
 // Throughput benchmark on the 3D cantilever of DESIGN.md section 6: particle-steps per second
 // of the full step (F, P, internal and hourglass forces, integrator). Not a test: it prints.
+// With it, the roofline's numbers (issue 12, docs/performance.md): the force passes' counted
+// memory traffic per particle-step, the bandwidth that traffic reaches, and the machine's own
+// bandwidth (a plain copy on the same threads).
 // Under mpirun (a build with MPI) the step is distributed as in `tlsph run`, and the time in
 // halo exchanges and reductions is reported (issue 11's scaling tables, docs/performance.md).
 #include <omp.h>
 
+#include <algorithm>
 #include <boost/program_options.hpp>
 #include <chrono>
 #include <cmath>
 #include <iostream>
 #include <memory>
+#include <vector>
 
 #include "tlsph/Lattice.hpp"
 #include "tlsph/Solver.hpp"
@@ -20,6 +25,34 @@
 
 namespace po = boost::program_options;
 using namespace tlsph;
+
+namespace {
+
+// Bytes per second of `b = a` over 2 x 512 MB (read + written, as STREAM counts a copy), best
+// of five, on the OpenMP threads; far out of any cache.
+double copyBandwidth() {
+  const std::size_t n = std::size_t(1) << 26;
+  std::vector<double> a(n), b(n);
+#pragma omp parallel for schedule(static)
+  for (std::size_t i = 0; i < n; ++i) {  // first touch by the threads that copy
+    a[i] = double(i);
+    b[i] = 0.0;
+  }
+  double best = 0.0;
+  for (int r = 0; r < 5; ++r) {
+    const auto start = std::chrono::steady_clock::now();
+#pragma omp parallel for schedule(static)
+    for (std::size_t i = 0; i < n; ++i)
+      b[i] = a[i];
+    const double t =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    best = std::max(best, 2.0 * sizeof(double) * n / t);
+  }
+  if (b[n / 2] != a[n / 2]) std::cerr << "copy check failed\n";
+  return best;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
 #ifdef TLSPH_HAVE_MPI
@@ -35,7 +68,8 @@ int main(int argc, char** argv) {
   const int ranks = 1;
 #endif
   double dx = 0.0125, supportRatio = 2.1, alpha = 10.0, length = 1.0;
-  long steps = 200;
+  long steps = 200, particles = 0;
+  bool stream = true;
   std::string material = "neo-hookean", correction = "linear", form = "energy",
               quadrature = "nodal";
   po::options_description options("tlsph_bench: 3D cantilever throughput");
@@ -46,6 +80,9 @@ int main(int argc, char** argv) {
                                                   "hourglass coefficient")(
       "material", po::value(&material)->default_value(material), "material model")(
       "steps", po::value(&steps)->default_value(steps), "time steps to time")(
+      "particles", po::value(&particles),
+      "about this many body particles: sets dx (the 1 m beam, n x n cross-section, 10 n^3)")(
+      "no-stream", "skip measuring the copy bandwidth")(
       "length", po::value(&length)->default_value(length),
       "beam length [m] (cross-section 0.1 x 0.1; weak scaling: length x ranks)")(
       "correction", po::value(&correction)->default_value(correction),
@@ -63,6 +100,9 @@ int main(int argc, char** argv) {
 #endif
     return 0;
   }
+
+  if (particles > 0) dx = 0.1 / std::max(1L, std::lround(std::cbrt(particles / (10.0 * length))));
+  stream = !vm.count("no-stream");
 
   Scene<3> scene;
   scene.materials.push_back(
@@ -113,6 +153,20 @@ int main(int argc, char** argv) {
   solver.synchronize();  // (distributed: the tip's displacement from its rank)
   std::cout << "steps " << steps << ", wall " << seconds << " s, particle-steps/s " << rate
             << ", tip u_z " << scene.particles.displacement[nx - 1].z() << "\n";
+  // The roofline: what the force passes must move per particle-step (TlsphForces::traffic),
+  // against what a plain copy moves on this machine with the same threads.
+  const auto traffic = solver.forces().traffic();
+  const double pairsPerParticle = double(nb.pairCount()) / nb.particleCount();
+  const double bytes = traffic.perPair * pairsPerParticle + traffic.perParticle;
+  std::cout << "traffic (counted, force passes) " << traffic.perPair << " B per pair + "
+            << traffic.perParticle << " B per particle = " << bytes / 1e3
+            << " kB per particle-step; reached " << rate * bytes / 1e9 << " GB/s";
+  if (stream && ranks == 1) {
+    const double copy = copyBandwidth();
+    std::cout << " = " << 100.0 * rate * bytes / copy << " % of a plain copy's " << copy / 1e9
+              << " GB/s (" << omp_get_max_threads() << " threads)";
+  }
+  std::cout << "\n";
 #ifdef TLSPH_HAVE_MPI
   if (comm) {
     // Per step, the slowest rank's time in exchanges (their wait for the slowest included)

@@ -194,6 +194,49 @@ class TlsphForces {
                : 0.0;
   }
 
+  // The memory traffic of one compute(), counted from the arrays the passes touch (issue 12's
+  // roofline): each per-pair array streamed once per pass that reads it, each per-particle
+  // array read or written once per pass; neighbours' values (u_J, F_J, S_J, R_J) assumed to
+  // hit the cache, so this is the compulsory traffic. Kept next to the loops it describes.
+  struct Traffic {
+    double perPair = 0.0;      // bytes per neighbour pair
+    double perParticle = 0.0;  // bytes per particle
+  };
+  Traffic traffic() const {
+    constexpr double I = sizeof(Index), V = sizeof(Vec<D>), M = sizeof(Mat<D>), d = sizeof(double);
+    const bool taylor = quadrature_ != nullptr;
+    constexpr double S = sizeof(typename TaylorQuadrature<D>::Sym),
+                     SM = sizeof(typename TaylorQuadrature<D>::SymMatrix);
+    Traffic t;
+    // F pass: j and g_IJ (+ S_IJ); offset, group entry, u_I; writes F, P (+ P + P^q, the
+    // second gradients and the hyperstress, reading the particle's three constants).
+    t.perPair += I + V + (taylor ? S : 0.0);
+    t.perParticle += 2 * I + V + 2 * M + (taylor ? M + 2 * SM + 3 * d : 0.0);
+    if (separateHourglassGradient_) {  // the penalty's own F through g^lin_IJ
+      t.perPair += I + V;
+      t.perParticle += I + V + M;
+    }
+    if (energyHourglass_) {  // j, X_IJ, c_IJ; u_I, F_I, P_I, moments, V_I; writes P + P^hg, spring
+      t.perPair += I + V + d;
+      t.perParticle += I + V + M + (separateHourglassGradient_ ? 0.0 : M) + M + V + V + M + d;
+    }
+    // Force pass: j, t_IJ (+ T_IJ) (+ t^lin_IJ); S_I, G_I (+ R_I, Sum_I), V_I; writes f.
+    t.perPair += I + V + (taylor ? S : 0.0) + (separateHourglassGradient_ ? V : 0.0);
+    t.perParticle += I + M + V + (taylor ? SM + S : 0.0) + d + V;
+    if (ganzenmueller_ || viscosity_) t.perParticle += V;    // u_I for x_IJ
+    if (separateHourglassGradient_) t.perParticle += M + V;  // P^hg_I, G^lin_I
+    if (energyHourglass_) t.perParticle += V;                // the spring force
+    if (ganzenmueller_) {  // X_IJ, c_IJ; F_I of the penalty; writes its force
+      t.perPair += V + d;
+      t.perParticle += M + V;
+    }
+    if (viscosity_) {  // X_IJ (if not already), the pair's two coefficients; v_I; writes its force
+      t.perPair += (ganzenmueller_ ? 0.0 : V) + 2 * d;
+      t.perParticle += 2 * V;
+    }
+    return t;
+  }
+
   // K_I = sum_J k_IJ per particle: the penalty's spring stiffness (empty when it is off).
   const std::vector<double>& hourglassStiffness() const { return hourglassStiffness_; }
 

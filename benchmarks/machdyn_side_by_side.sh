@@ -1,0 +1,146 @@
+#!/bin/bash
+# Side-by-side throughput of LAMMPS's MACHDYN (pair smd/tlsph) and build/tlsph_bench on the same
+# 3D cantilever (benchmarks/bench_cantilever.cpp; issue 12). Needs a LAMMPS built from source with
+# the MACHDYN package (not a tlsph dependency). Prints particle-steps/s = atoms x steps / loop time.
+# Written from LAMMPS's documentation, examples and sources (cited below); the development machine
+# has no LAMMPS, so the generated input has not been run there.
+# Usage: benchmarks/machdyn_side_by_side.sh LMP_BINARY [dx] [steps] [procs...]
+#   defaults: dx 0.0125 (5,312 particles), steps 200, procs "1 2" (MACHDYN: MPI ranks, one
+#   OpenMP thread each; tlsph: OpenMP threads, one process). Issue 12's sizes: 0.0125 2000 and
+#   0.00625 200. Environment: MPIRUN (default mpirun), HG (both codes' hourglass coefficient,
+#   default 10), CFL (default 0.3).
+#
+# Equal in both codes: the particles (cell-centred cubic lattice of spacing dx: an 80 x 8 x 8 body
+# at dx 0.0125 plus ceil(2.1) = 3 clamp layers at x < 0 that never move), volume dx^3, density
+# 1000, E = 1e7, nu = 0.3, gravity (0, 0, -1), the kernel support H = 2.1 dx (32 neighbours
+# inside), the step count, no artificial viscosity, and one fixed time step of CFL dx / c with
+# c = sqrt((K + 4G/3)/rho). tlsph adds the hourglass term's speed to c (src/tlsph/TimeStep.hpp),
+# so its dt is a little smaller; the table shows both. The cost of a step does not depend on dt.
+# NOT equal: the material model. MACHDYN has no neo-Hookean model; its only elastic model is
+# hypoelastic: *STRENGTH_LINEAR (deviatoric stress rate 2G d_dev) with *EOS_LINEAR (pressure rate
+# K tr d), co-rotated by the polar decomposition of F, as in LAMMPS's rubber examples.
+# (*LINEAR_DEFGRAD is parsed but stops with "only for debugging purposes and currently
+# deactivated" in src/MACHDYN/pair_smd_tlsph.cpp.) Nor the hourglass term: MACHDYN's hg scales a
+# pairwise spring on the error of F dX against dx by E; tlsph's alpha scales its energy penalty
+# (--form ganzenmueller is the textbook form of MACHDYN's term; not timed here). The kernels
+# differ (MACHDYN: spiky; tlsph: Wendland C2), MACHDYN visits each pair from both particles, and
+# it evaluates its artificial viscosity term even at q1 = q2 = 0.
+# The last column, the tip's u_z, only checks that both move the same scene: early on it is near
+# -g t^2 / 2 with t = (steps + 1) dt in both (scale by the dt ratio); no accuracy comparison.
+set -u
+cd "$(dirname "$0")/.."
+[ $# -ge 1 ] || { sed -n 5,9p "$0"; exit 2; }
+LMP=$1; [[ $LMP == */* ]] && LMP=$(readlink -f "$LMP")
+command -v "$LMP" >/dev/null || { echo "no LAMMPS binary at $1" >&2; exit 2; }
+dx=${2:-0.0125}; steps=${3:-200}; shift $(($# < 3 ? $# : 3)); procs=${*:-1 2}
+MPIRUN=${MPIRUN:-mpirun}; HG=${HG:-10}; CFL=${CFL:-0.3}; support=2.1
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1  # as benchmarks/scaling.sh
+# Lattice counts as in bench_cantilever.cpp (lround, ceil) and the CFL step dt = CFL dx / c.
+read -r nx ny layers dt < <(awk -v dx="$dx" -v s="$support" -v cfl="$CFL" 'BEGIN {
+  E = 1e7; nu = 0.3; rho = 1000; lambda = E*nu/((1+nu)*(1-2*nu)); G = E/(2*(1+nu))
+  l = int(s); if (l < s) l++
+  printf "%d %d %d %.6g\n", int(1/dx + 0.5), int(0.1/dx + 0.5), l, cfl*dx/sqrt((lambda+2*G)/rho) }')
+work=$(mktemp -d /tmp/machdyn_side_by_side.XXXXXX)
+
+# The LAMMPS input, after examples/PACKAGES/machdyn/rubber_strip_pull/in.rubber_strip_pull (same
+# commands in 2D) and rubber_rings_3d (3D, boundary m m m). LAMMPS's beam spans y, z in [0, 0.1],
+# not [-0.05, 0.05]: the lattice origin then needs no offset, and a translation changes nothing.
+cat >"$work/in.cantilever" <<'EOF'
+dimension       3
+units           si
+boundary        m m m
+atom_style      smd                 # per-atom volume, mass, kernel radius, reference position x0
+atom_modify     map array           # required: smd/tlsph finds partners by atom ID
+comm_modify     vel yes
+newton          off                 # required by pair smd/tlsph
+neighbor        ${dx} bin           # skin dx: displacements here stay far below it
+neigh_modify    every 10 delay 0 check yes
+
+variable        w equal ${ny}*${dx}
+variable        xbody equal ${nx}*${dx}
+variable        xclamp equal -${layers}*${dx}
+variable        xlo equal -(${layers}+1)*${dx}
+variable        xhi equal (${nx}+1)*${dx}
+variable        lo equal -${dx}
+variable        hi equal (${ny}+1)*${dx}
+variable        xtip equal (${nx}-1)*${dx}
+lattice         sc ${dx} origin 0.5 0.5 0.5     # points at (i + 1/2) dx: cell-centred
+region          box block ${xlo} ${xhi} ${lo} ${hi} ${lo} ${hi} units box
+create_box      1 box
+region          body block 0 ${xbody} 0 ${w} 0 ${w} units box
+region          clamp block ${xclamp} 0 0 ${w} 0 ${w} units box
+create_atoms    1 region body       # create_atoms sets x0 = x and molecule 1 (atom_vec_smd.cpp)
+create_atoms    1 region clamp
+group           body region body
+group           clamp region clamp
+group           tlsph union body clamp  # pair smd/tlsph requires a group named tlsph
+variable        vol equal ${dx}^3
+variable        h equal ${support}*${dx}
+set             group all volume ${vol}
+set             group all smd/mass/density 1000   # mass = density x volume: set volume first
+set             group all diameter ${h}   # kernel radius = radius_i + radius_j = diameter = H
+
+# *COMMON rho0 E nu Q1 Q2 hg Cp (Q1, Q2: artificial viscosity, off; Cp: heat capacity, unused)
+pair_style      smd/tlsph
+pair_coeff      1 1 *COMMON 1000 1e7 0.3 0 0 ${hg} 1 &
+                *STRENGTH_LINEAR &
+                *EOS_LINEAR &
+                *END
+
+# The clamp is not integrated: it keeps x = x0 and v = 0, as tlsph's prescribed particles.
+fix             integrate body smd/integrate_tlsph
+fix             grav body gravity 1.0 vector 0 0 -1   # acceleration: force = rmass g
+timestep        ${dt}               # fixed: no fix smd/adjust_dt
+
+# The particle tlsph_bench reports (index nx - 1: tip, lowest y and z); its u_z.
+region          tip block ${xtip} ${xbody} 0 ${dx} 0 ${dx} units box
+group           tip region tip
+variable        tipuz equal xcm(tip,z)-0.5*${dx}
+thermo_style    custom step v_tipuz
+run             1                   # warm-up, one step as tlsph_bench's (the setup's force call
+                                    # only builds the reference partner lists)
+run             ${steps}
+EOF
+
+echo "# dx $dx: ${nx}x${ny}x${ny} body + $layers clamp layers, $steps steps, hg = alpha = $HG;" \
+  "MACHDYN logs in $work"
+row="%-8s %-18s %5s %9s %6.1f %10.4g %9.3f %12.4g %9s %12.4g\n"
+printf "%-8s %-18s %5s %9s %6s %10s %9s %12s %9s %12s\n" code config procs particles neighb \
+  "dt [s]" "wall [s]" "p-steps/s" "tlsph/MD" "tip u_z [m]"
+declare -A machdyn
+for p in $procs; do
+  out=$work/out.$p; log=$work/log.$p
+  OMP_NUM_THREADS=1 $MPIRUN -np "$p" "$LMP" -in "$work/in.cantilever" -log "$log" -screen none \
+    -var dx "$dx" -var nx "$nx" -var ny "$ny" -var layers "$layers" -var support "$support" \
+    -var hg "$HG" -var dt "$dt" -var steps "$steps" >"$out" 2>&1
+  # "Loop time of T on P procs for N steps with A atoms": the last run is the timed one.
+  T=; read -r T P N A < <(grep -s "^Loop time of" "$log" | tail -1 | awk '{print $4, $6, $9, $12}')
+  if [ -z "$T" ]; then echo "MACHDYN on $p ranks failed:"; tail -n 5 "$out" "$log"; continue; fi
+  nb=$(grep "average # of neighbors/particle in group tlsph" "$log" | tail -1 | awk '{print $NF}')
+  uz=$(awk '/^Loop time of/ {print last} {last = $0}' "$log" | tail -1 | awk '{print $2}')
+  machdyn[$p]=$(awk -v a="$A" -v n="$N" -v t="$T" 'BEGIN {print a*n/t}')
+  printf "$row" MACHDYN linear-hypoelastic "${P}r" "$A" "${nb:-0}" "$dt" "$T" "${machdyn[$p]}" - \
+    "${uz:-0}"
+  grep -q "deleting particle" "$out" && echo "  warning: MACHDYN deleted particles (det F out of" \
+    "range): the step is unstable for it, lower CFL"
+done
+
+[ -x build/tlsph_bench ] || { echo "(no build/tlsph_bench: build tlsph to compare)"; exit 0; }
+# Skip the bench's copy-bandwidth measurement (roofline) where it has one: not part of the step.
+extra=$(build/tlsph_bench --help | grep -q -- --no-stream && echo --no-stream)
+for config in "bench-default" "quadratic-taylor"; do
+  args="--dx $dx --steps $steps --alpha $HG $extra"
+  [ "$config" = quadratic-taylor ] && args="$args --correction quadratic --quadrature taylor"
+  for p in $procs; do
+    out=$(OMP_NUM_THREADS=$p build/tlsph_bench $args 2>&1)
+    n=$(grep -o "^particles [0-9]*" <<<"$out" | cut -d' ' -f2)
+    nb=$(grep -o "mean neighbours [0-9.e+-]*" <<<"$out" | cut -d' ' -f3)
+    tdt=$(grep -o ", dt [0-9.e+-]*" <<<"$out" | cut -d' ' -f3)
+    wall=$(grep -o "wall [0-9.e+-]* s" <<<"$out" | cut -d' ' -f2)
+    rate=$(grep -o "particle-steps/s [0-9.e+-]*" <<<"$out" | cut -d' ' -f2)
+    uz=$(grep -o "tip u_z [0-9.e+-]*" <<<"$out" | cut -d' ' -f3)
+    [ -n "$rate" ] || { echo "tlsph_bench $args failed:"; tail -n 5 <<<"$out"; continue; }
+    ratio=$(awk -v a="$rate" -v b="${machdyn[$p]:-}" 'BEGIN {print b ? sprintf("%.2f", a/b) : "-"}')
+    printf "$row" tlsph "$config" "${p}t" "$n" "$nb" "$tdt" "$wall" "$rate" "$ratio" "$uz"
+  done
+done
