@@ -87,10 +87,11 @@ struct ReferenceConfiguration {
 // binary search in J's sorted list. Throws SetupError if a list is not symmetric.
 // hasRow (lists built for some particles only, buildNeighbourRows): a pair whose neighbour has
 // no list of its own gets zero.
-template <class Value>
-std::vector<Value> reversePairValues(const NeighbourList& nb, const std::vector<Value>& a,
-                                     const std::vector<double>& volume,
-                                     const std::vector<std::uint8_t>* hasRow = nullptr) {
+// valueOf(k): a_k for pair k (reversePairValuesOf, for values stored inside larger records).
+template <class Value, class ValueOf>
+std::vector<Value> reversePairValuesOf(const NeighbourList& nb, ValueOf&& valueOf,
+                                       const std::vector<double>& volume,
+                                       const std::vector<std::uint8_t>* hasRow = nullptr) {
   std::vector<Value> t(nb.pairCount());
   const Index n = nb.particleCount();
   bool symmetric = true;
@@ -109,10 +110,18 @@ std::vector<Value> reversePairValues(const NeighbourList& nb, const std::vector<
         symmetric = false;
         continue;
       }
-      t[k] = (volume[j] / volume[i]) * a[at - nb.neighbour.begin()];
+      t[k] = (volume[j] / volume[i]) * valueOf(Index(at - nb.neighbour.begin()));
     }
   if (!symmetric) throwAsymmetricNeighbourLists();
   return t;
+}
+
+template <class Value>
+std::vector<Value> reversePairValues(const NeighbourList& nb, const std::vector<Value>& a,
+                                     const std::vector<double>& volume,
+                                     const std::vector<std::uint8_t>* hasRow = nullptr) {
+  return reversePairValuesOf<Value>(
+      nb, [&](Index k) -> const Value& { return a[k]; }, volume, hasRow);
 }
 
 template <int D>

@@ -19,7 +19,9 @@ TaylorQuadrature<D>::TaylorQuadrature(const ReferenceConfiguration<D>& ref,
     : ref_(ref), volume_(volume) {
   const auto& nb = ref.neighbours;
   const Index n = ref.particleCount();
-  S_.assign(nb.pairCount(), Sym::Zero());
+  fit_.resize(nb.pairCount());
+  for (std::size_t k = 0; k < fit_.size(); ++k)  // S_IJ = 0 unless the fit below sets it
+    fit_[k] << ref.correctedGradient[k].transpose(), Sym::Zero().transpose();
   sum_.assign(n, Sym::Zero());
   weight_.assign(n, 0.0);
   lambda_.assign(n, 0.0);
@@ -64,12 +66,14 @@ TaylorQuadrature<D>::TaylorQuadrature(const ReferenceConfiguration<D>& ref,
           const double v = c[D + t] / (l * l);
           s[t] = a == b ? 2.0 * v : v;  // S_IJ(a, b)
         }
-      S_[k] = s;
+      fit_[k].template tail<P>() = s.transpose();
       sum_[i] += s;
     }
   }
   // T_IJ = (V_J / V_I) S_JI
-  reverse_ = reversePairValues(nb, S_, volume, ref.rows());
+  reverse_ = reversePairValuesOf<Sym>(
+      nb, [&](Index k) -> Sym { return fit_[k].template tail<P>().transpose(); }, volume,
+      ref.rows());
   G_.assign(n, SymMatrix::Zero());
   R_.assign(n, SymMatrix::Zero());
   force_.assign(n, Vec<D>::Zero());

@@ -46,6 +46,9 @@ class TaylorQuadrature {
   static constexpr int P = D * (D + 1) / 2;
   using Sym = Eigen::Matrix<double, P, 1>;
   using SymMatrix = Eigen::Matrix<double, D, P>;
+  // A pair's whole fit, [g_IJ, S_IJ]: the gradient vector and the second-derivative vector in
+  // one record, so that the F pass reads one stream and multiplies it as one row (gradients()).
+  using Fit = Eigen::Matrix<double, 1, D + P>;
 
   // Builds the second-derivative vectors S_IJ from the quadratic fit (TaylorQuadrature.cpp).
   TaylorQuadrature(const ReferenceConfiguration<D>& ref, const std::vector<Material>& materials,
@@ -58,7 +61,7 @@ class TaylorQuadrature {
     SymMatrix Gs = SymMatrix::Zero();
     const Vec<D> ui = u[i];
     for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k)
-      Gs.noalias() += (u[nb.neighbour[k]] - ui) * S_[k].transpose();
+      Gs.noalias() += (u[nb.neighbour[k]] - ui) * fit_[k].template tail<P>();
     return unpack(Gs);
   }
 
@@ -75,11 +78,30 @@ class TaylorQuadrature {
   }
 
   // The force pass's parts, fused into TlsphForces' loops (one pass over the pairs each):
-  // in the F loop, Gs += (u_J - u_I) (x) S_IJ beside F (gather), then stressAt(i, F_I, Gs) =
-  // P^q_I, added to the stress sent through g_IJ, which also keeps G_I and the hyperstress
+  // in the F loop, grad u and Gs = grad grad u together (gradients), then stressAt(i, F_I, Gs)
+  // = P^q_I, added to the stress sent through g_IJ, which also keeps G_I and the hyperstress
   // R_I; in the force loop, f_I += V_I (R_I . Sum_I - sum_J R_J . T_IJ) (hyperForce*).
-  void gather(Index k, const Vec<D>& du, SymMatrix& Gs) const {
-    Gs.noalias() += du * S_[k].transpose();
+  //
+  // [grad u | Gs] = sum_J (u_J - u_I) (x) [g_IJ, S_IJ] (6.69 and the fit's second
+  // derivatives): row a accumulates du_a [g_IJ, S_IJ], one (D + P)-wide multiply-add per row
+  // and pair, which vectorises across the row (measured 8-11 % faster per step in 3D than the
+  // separate D x D and D x P products, issue 12).
+  void gradients(Index i, const std::vector<Vec<D>>& u, Mat<D>& gradU, SymMatrix& Gs) const {
+    const auto& nb = ref_.neighbours;
+    std::array<Fit, D> rows;
+    for (auto& row : rows)
+      row.setZero();
+    const Vec<D> ui = u[i];
+    for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
+      const Vec<D> du = u[nb.neighbour[k]] - ui;
+      const Fit& c = fit_[k];
+      for (int a = 0; a < D; ++a)
+        rows[a].noalias() += du[a] * c;
+    }
+    for (int a = 0; a < D; ++a) {
+      gradU.row(a) = rows[a].template head<D>();
+      Gs.row(a) = rows[a].template tail<P>();
+    }
   }
   Mat<D> stressAt(Index i, const Mat<D>& F, const SymMatrix& Gs) {
     if (weight_[i] == 0.0) return Mat<D>::Zero();  // R_i stays zero
@@ -198,7 +220,8 @@ class TaylorQuadrature {
 
   const ReferenceConfiguration<D>& ref_;
   const std::vector<double>& volume_;
-  std::vector<Sym> S_, reverse_, sum_;  // S_IJ, T_IJ = (V_J / V_I) S_JI, sum_J S_IJ
+  std::vector<Fit> fit_;            // [g_IJ, S_IJ]
+  std::vector<Sym> reverse_, sum_;  // T_IJ = (V_J / V_I) S_JI, sum_J S_IJ
   std::vector<double> weight_, lambda_, mu_;
   std::vector<std::uint8_t> smallStrain_;  // linear-elastic material: e_a = sym(G_a)
   std::vector<SymMatrix> G_;               // grad grad u, symmetric storage

@@ -280,14 +280,15 @@ class TlsphForces {
     for (Index p = 0; p < count; ++p) {
       const Index i = group[p];
       // deformationGradientOf written out: the hot loop measured 2-3 % slower through the call
-      const Vec<D> ui = u[i];
-      Mat<D> gradU = Mat<D>::Zero();
+      Mat<D> gradU;
       [[maybe_unused]] typename TaylorQuadrature<D>::SymMatrix Gs;
-      if constexpr (Taylor) Gs.setZero();
-      for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
-        const Vec<D> du = u[nb.neighbour[k]] - ui;
-        gradU.noalias() += du * ref_.correctedGradient[k].transpose();
-        if constexpr (Taylor) q->gather(k, du, Gs);  // grad grad u, beside F
+      if constexpr (Taylor) {
+        q->gradients(i, u, gradU, Gs);  // grad u and grad grad u in one pass
+      } else {
+        const Vec<D> ui = u[i];
+        gradU.setZero();
+        for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k)
+          gradU.noalias() += (u[nb.neighbour[k]] - ui) * ref_.correctedGradient[k].transpose();
       }
       const Mat<D> F = Mat<D>::Identity() + gradU;  // (6.69)
       F_[i] = F;
