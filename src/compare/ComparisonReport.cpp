@@ -1,7 +1,6 @@
 #include "compare/ComparisonReport.hpp"
 
 #include <cmath>
-#include <fstream>
 #include <iomanip>
 #include <sstream>
 #include <stdexcept>
@@ -129,16 +128,7 @@ std::string comparisonJson(const Comparison& c) {
 
 void writeComparisonJson(const Comparison& c, const std::filesystem::path& file) {
   const std::string text = comparisonJson(c);
-  try {
-    writeAtomically(file, [&](const std::filesystem::path& temporary) {
-      std::ofstream out(temporary, std::ios::binary);
-      out.write(text.data(), static_cast<std::streamsize>(text.size()));
-      out.close();
-      if (!out) throw std::runtime_error("cannot write JSON file " + file.string());
-    });
-  } catch (const std::filesystem::filesystem_error& e) {
-    throw std::runtime_error("cannot write JSON file " + file.string() + ": " + e.what());
-  }
+  writeTextAtomically(file, {text}, "JSON");
 }
 
 }  // namespace tlsph

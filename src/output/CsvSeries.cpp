@@ -94,17 +94,7 @@ void CsvSeries::flush() {
   }
   head += '\n';
 
-  try {
-    writeAtomically(file_, [&](const std::filesystem::path& temporary) {
-      std::ofstream out(temporary, std::ios::binary);
-      out.write(head.data(), static_cast<std::streamsize>(head.size()));
-      out.write(rows_.data(), static_cast<std::streamsize>(rows_.size()));
-      out.close();
-      if (!out) throw std::runtime_error("cannot write CSV file " + file_.string());
-    });
-  } catch (const std::filesystem::filesystem_error& e) {
-    throw std::runtime_error("cannot write CSV file " + file_.string() + ": " + e.what());
-  }
+  writeTextAtomically(file_, {head, rows_}, "CSV");
 }
 
 }  // namespace tlsph

@@ -1,7 +1,6 @@
 #include "output/PvdFile.hpp"
 
 #include <bit>
-#include <fstream>
 #include <stdexcept>
 #include <string>
 
@@ -22,16 +21,7 @@ void writePvdFile(const std::filesystem::path& pvd, const std::vector<PvdEntry>&
             "\"/>\n";
   text += "  </Collection>\n</VTKFile>\n";
 
-  try {
-    writeAtomically(pvd, [&](const std::filesystem::path& temporary) {
-      std::ofstream out(temporary, std::ios::binary);
-      out.write(text.data(), static_cast<std::streamsize>(text.size()));
-      out.close();
-      if (!out) throw std::runtime_error("cannot write PVD file " + pvd.string());
-    });
-  } catch (const std::filesystem::filesystem_error& e) {
-    throw std::runtime_error("cannot write PVD file " + pvd.string() + ": " + e.what());
-  }
+  writeTextAtomically(pvd, {text}, "PVD");
 }
 
 }  // namespace tlsph

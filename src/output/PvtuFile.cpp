@@ -1,7 +1,6 @@
 #include "output/PvtuFile.hpp"
 
 #include <bit>
-#include <fstream>
 #include <set>
 #include <stdexcept>
 
@@ -39,16 +38,7 @@ void writePvtuFile(const Frame& layout, const std::vector<std::string>& pieces,
     text += "    <Piece Source=\"" + xmlAttribute(piece) + "\"/>\n";
   text += "  </PUnstructuredGrid>\n</VTKFile>\n";
 
-  try {
-    writeAtomically(file, [&](const std::filesystem::path& temporary) {
-      std::ofstream out(temporary, std::ios::binary);
-      out.write(text.data(), static_cast<std::streamsize>(text.size()));
-      out.close();
-      if (!out) throw std::runtime_error("cannot write PVTU file " + file.string());
-    });
-  } catch (const std::filesystem::filesystem_error& e) {
-    throw std::runtime_error("cannot write PVTU file " + file.string() + ": " + e.what());
-  }
+  writeTextAtomically(file, {text}, "PVTU");
 }
 
 }  // namespace tlsph
