@@ -194,41 +194,6 @@ TEST(Hourglass, OpposesAZigZagMode) {
   expectOpposesZigZag<3>(kTextbook);
 }
 
-// The energy form's pass takes a free body's X_IJ as X_I - X_J from the positions instead of
-// streaming the stored separation (issue 12): that must be the stored separation bit for bit,
-// and the periodic path (which reads it) must give the same forces when no image is involved.
-template <int D>
-void expectPenaltyPassesAgreeOnTheSeparation(std::uint32_t seed) {
-  std::mt19937 rng(seed);
-  auto scene = HourglassCase<D>::scene(HourglassCase<D>::cloud(rng), 10.0, kEnergy,
-                                       GradientCorrection::Quadratic, HourglassGradient::Corrected);
-  scene.quadrature = Quadrature::Taylor;
-  ForceEvaluator<D> free(scene);
-  // periodic along x with a period 15 times the body: every minimum image is the plain one
-  scene.periodicBox.periodic[0] = true;
-  scene.periodicBox.length[0] = 1.0;
-  ForceEvaluator<D> periodic(std::move(scene));
-  ASSERT_FALSE(free.reference().box.any());
-  ASSERT_TRUE(periodic.reference().box.any());
-  const auto& ref = free.reference();
-  const auto& nb = ref.neighbours;
-  for (Index i = 0; i < ref.particleCount(); ++i)
-    for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k)
-      ASSERT_EQ(Vec<D>(ref.position[i] - ref.position[nb.neighbour[k]]), ref.separation[k])
-          << "pair " << i << "-" << nb.neighbour[k];
-  std::vector<Vec<D>> u(free.size());
-  for (auto& ui : u)
-    ui = randomVector<D>(rng, 0.05 * 0.01);
-  const auto f = free.force(u), fp = periodic.force(u);
-  for (std::size_t i = 0; i < f.size(); ++i)
-    ASSERT_EQ(f[i], fp[i]) << "particle " << i;
-}
-
-TEST(Hourglass, PenaltyPassTakesAFreeBodysSeparationFromThePositions) {
-  expectPenaltyPassesAgreeOnTheSeparation<2>(41);
-  expectPenaltyPassesAgreeOnTheSeparation<3>(42);
-}
-
 TEST(Hourglass, OffMeansNotComputed) {
   std::mt19937 rng(35);
   for (auto form : {kEnergy, kTextbook}) {

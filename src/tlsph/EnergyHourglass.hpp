@@ -47,17 +47,40 @@ class EnergyHourglass {
   void evaluate(const std::vector<Vec<D>>& u, const std::vector<Mat<D>>& F,
                 const std::vector<Mat<D>>* P, std::vector<Mat<D>>& stress,
                 const std::vector<Index>* particles = nullptr) {
-    // A free body's X_IJ = X_I - X_J from the positions (two values in cache), bit for bit
-    // the stored separation without its stream of 24 B per pair; a periodic body's minimum
-    // image is read.
-    if (ref_.box.any())
-      evaluatePairs<Gradient, true>(u, F, P, stress, particles);
-    else
-      evaluatePairs<Gradient, false>(u, F, P, stress, particles);
+    const auto& nb = ref_.neighbours;
+    const Index count = particles ? static_cast<Index>(particles->size()) : ref_.particleCount();
+    const Index* list = particles ? particles->data() : nullptr;
+#pragma omp parallel for schedule(static)
+    for (Index p = 0; p < count; ++p) {
+      const Index i = list ? list[p] : p;
+      const Vec<D> ui = u[i];
+      Vec<D> sum = Vec<D>::Zero();
+      Mat<D> moment = Mat<D>::Zero();
+      for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
+        const Index j = nb.neighbour[k];
+        const Vec<D>& Xij = ref_.separation[k];
+        const Vec<D> HjX = Gradient ? Vec<D>(F[j] * Xij) : Vec<D>(F[j] * Xij - Xij);
+        const Vec<D> w = c_[k] * ((ui - u[j]) - 0.5 * HjX);
+        sum += w;
+        moment.noalias() += w * Xij.transpose();
+      }
+      const Mat<D> Hi = Gradient ? F[i] : Mat<D>(F[i] - Mat<D>::Identity());
+      sum -= 0.5 * (Hi * sumCX_[i]);                // sum_J c_IJ e_IJ
+      moment.noalias() -= 0.5 * (Hi * sumCXX_[i]);  // sum_J c_IJ e_IJ (x) X_IJ
+      // P + P^hg, written as expressions: a Mat = Mat copy here is an out-of-line call once
+      // the unit holds enough of them, and that spills the loop's sums to memory
+      if (P)
+        stress[i].noalias() = (*P)[i] - 0.5 * moment;
+      else
+        stress[i].noalias() = -0.5 * moment;
+      spring_[i] = -volume_[i] * sum;  // -sum_J k_IJ e_IJ
+    }
   }
 
   // Spring part of the force on particle i from the last evaluate().
-  const Vec<D>& springForce(Index i) const { return spring_[i]; }
+  const Vec<D>& springForce(Index i) const {
+    return spring_[i];
+  }
 
   // E_hg = 1/4 sum_I V_I sum_J c_IJ |e_IJ|^2 for the displacements u and gradients F
   // (a diagnostic pass, not part of the force). Distributed: each rank its particles', summed
@@ -83,42 +106,6 @@ class EnergyHourglass {
   }
 
  private:
-  template <bool Gradient, bool Periodic>
-  void evaluatePairs(const std::vector<Vec<D>>& u, const std::vector<Mat<D>>& F,
-                     const std::vector<Mat<D>>* P, std::vector<Mat<D>>& stress,
-                     const std::vector<Index>* particles) {
-    const auto& nb = ref_.neighbours;
-    const auto& X = ref_.position;
-    const Index count = particles ? static_cast<Index>(particles->size()) : ref_.particleCount();
-    const Index* list = particles ? particles->data() : nullptr;
-#pragma omp parallel for schedule(static)
-    for (Index p = 0; p < count; ++p) {
-      const Index i = list ? list[p] : p;
-      const Vec<D> ui = u[i];
-      [[maybe_unused]] const Vec<D> Xi = X[i];
-      Vec<D> sum = Vec<D>::Zero();
-      Mat<D> moment = Mat<D>::Zero();
-      for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
-        const Index j = nb.neighbour[k];
-        const Vec<D> Xij = Periodic ? ref_.separation[k] : Vec<D>(Xi - X[j]);
-        const Vec<D> HjX = Gradient ? Vec<D>(F[j] * Xij) : Vec<D>(F[j] * Xij - Xij);
-        const Vec<D> w = c_[k] * ((ui - u[j]) - 0.5 * HjX);
-        sum += w;
-        moment.noalias() += w * Xij.transpose();
-      }
-      const Mat<D> Hi = Gradient ? F[i] : Mat<D>(F[i] - Mat<D>::Identity());
-      sum -= 0.5 * (Hi * sumCX_[i]);                // sum_J c_IJ e_IJ
-      moment.noalias() -= 0.5 * (Hi * sumCXX_[i]);  // sum_J c_IJ e_IJ (x) X_IJ
-      // P + P^hg, written as expressions: a Mat = Mat copy here is an out-of-line call once
-      // the unit holds enough of them, and that spills the loop's sums to memory
-      if (P)
-        stress[i].noalias() = (*P)[i] - 0.5 * moment;
-      else
-        stress[i].noalias() = -0.5 * moment;
-      spring_[i] = -volume_[i] * sum;  // -sum_J k_IJ e_IJ
-    }
-  }
-
   const ReferenceConfiguration<D>& ref_;
   std::vector<double> c_;
   const std::vector<double>& volume_;

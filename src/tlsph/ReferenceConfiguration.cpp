@@ -54,8 +54,6 @@ ReferenceConfiguration<D> buildReferenceConfiguration(
     const std::vector<Index>* rows) {
   ReferenceConfiguration<D> ref;
   ref.correction = correction;
-  ref.position = X;
-  ref.box = box;
   ref.neighbours = rows ? buildNeighbourRows<D>(X, *rows, kernel.supportRadius(), box)
                         : buildNeighbourList<D>(X, kernel.supportRadius(), box);
   const auto& nb = ref.neighbours;

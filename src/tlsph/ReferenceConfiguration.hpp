@@ -66,10 +66,6 @@ struct ReferenceConfiguration {
   // V_I (P_I G_I - sum_J P_J t_IJ) with one pass over I's own list.
   std::vector<Vec<D>> reverseGradient;
   // Per particle:
-  // X_I and the box: a per-step pass that needs X_IJ of a free body computes X_I - X_J from
-  // these (two values in cache) rather than streaming separation (24 B per pair; issue 12).
-  std::vector<Vec<D>> position;
-  PeriodicBox<D> box;
   std::vector<Mat<D>> correctionInverse;     // L_I^{-1}, (6.44)
   std::vector<Vec<D>> gradientSum;           // s_I = sum_J w_IJ
   std::vector<Vec<D>> correctedGradientSum;  // G_I = sum_J g_IJ

@@ -216,10 +216,9 @@ class TlsphForces {
       t.perPair += I + V;
       t.perParticle += I + V + M;
     }
-    if (energyHourglass_) {  // j, c_IJ (+ X_IJ if periodic); u_I, X_I, F_I, P_I, moments, V_I;
-                             // writes P + P^hg, spring
-      t.perPair += I + d + (ref_.box.any() ? V : 0.0);
-      t.perParticle += I + 2 * V + M + (separateHourglassGradient_ ? 0.0 : M) + M + V + V + M + d;
+    if (energyHourglass_) {  // j, X_IJ, c_IJ; u_I, F_I, P_I, moments, V_I; writes P + P^hg, spring
+      t.perPair += I + V + d;
+      t.perParticle += I + V + M + (separateHourglassGradient_ ? 0.0 : M) + M + V + V + M + d;
     }
     // Force pass: j, t_IJ (+ T_IJ) (+ t^lin_IJ); S_I, G_I (+ R_I, Sum_I), V_I; writes f.
     t.perPair += I + V + (taylor ? S : 0.0) + (separateHourglassGradient_ ? V : 0.0);
