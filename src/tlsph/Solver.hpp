@@ -19,6 +19,7 @@
 #include "tlsph/ReferenceConfiguration.hpp"
 #include "tlsph/ReproducibleSum.hpp"
 #include "tlsph/Scene.hpp"
+#include "tlsph/SubnormalsToZero.hpp"
 #include "tlsph/TimeStep.hpp"
 #include "tlsph/TlsphForces.hpp"
 
@@ -223,6 +224,7 @@ class Solver {
   const std::vector<Vec<D>>& externalForce() const { return external_; }
 
   void step() {
+    const SubnormalsToZero subnormals;  // wave precursors: SubnormalsToZero.hpp
     auto& p = scene_.particles;
     const double halfDt = 0.5 * dt_;
     const double c = scene_.damping.viscous;
