@@ -160,7 +160,11 @@ class Solver {
     updateMirrorDrive(0.0);
     mirrorGhostMotion();
     if (forces_.viscosityEnabled()) forceVelocity_ = scene.particles.velocity;
-    forces_.compute(scene.particles.displacement, scene.particles.force, &scene.particles.velocity);
+    {
+      const SubnormalsToZero subnormals;  // every force of a run in the step's mode
+      forces_.compute(scene.particles.displacement, scene.particles.force,
+                      &scene.particles.velocity);
+    }
     chainMirrorForces();
     previousKinetic_ = kineticEnergy(scene.particles);
   }
@@ -481,6 +485,7 @@ class Solver {
         (forces_.viscosityEnabled() && s.forceVelocity.size() != n))
       throw SetupError("the saved state holds " + std::to_string(s.displacement.size()) +
                        " particles, the scene " + std::to_string(n));
+    const SubnormalsToZero subnormals;  // the forces as the step computed them
     time_ = s.time;
     steps_ = s.steps;
     previousKinetic_ = s.previousKinetic;
@@ -508,6 +513,7 @@ class Solver {
   // present displacements and velocities, without advancing: for a state put back from a
   // copy, e.g. to write the last good frame of a run that went unstable.
   void reevaluate() {
+    const SubnormalsToZero subnormals;  // as in step()
     auto& p = scene_.particles;
     mirrorGhostMotion();
     if (forces_.viscosityEnabled()) forceVelocity_ = p.velocity;

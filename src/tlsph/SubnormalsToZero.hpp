@@ -9,7 +9,9 @@
 // scale is 1e-12 to 1e9 in SI units is nothing a result can show, so the step computes with
 // them as zero: FTZ (results) and DAZ (operands) on x86-64, FZ on AArch64 (written, not run
 // here), on the calling thread and on every thread of the OpenMP team. The previous mode is
-// restored afterwards, so code around a step computes as before.
+// restored afterwards, so code around a step computes as before. Every force of an explicit
+// run is computed in this mode (the step, the first forces, a restored state's, reevaluate):
+// a restart recomputes exactly the bits the uninterrupted run had.
 #pragma once
 
 #if defined(__SSE2__) || defined(_M_X64)
