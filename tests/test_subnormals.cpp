@@ -42,6 +42,7 @@ TEST(SubnormalsToZero, FlushesOnEveryThreadAndRestoresAfterwards) {
   if (!SubnormalsToZero::supported()) GTEST_SKIP() << "no flush-to-zero mode on this target";
   ASSERT_EQ(std::fpclassify(subnormalProduct()), FP_SUBNORMAL);  // the default mode
 #ifdef _OPENMP
+  const int threadsBefore = omp_get_max_threads();
   omp_set_num_threads(3);
 #endif
   {
@@ -66,7 +67,7 @@ TEST(SubnormalsToZero, FlushesOnEveryThreadAndRestoresAfterwards) {
   }
   EXPECT_EQ(kept, threads);
 #ifdef _OPENMP
-  omp_set_num_threads(1);
+  omp_set_num_threads(threadsBefore);
 #endif
 }
 

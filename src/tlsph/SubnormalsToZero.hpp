@@ -11,7 +11,9 @@
 // here), on the calling thread and on every thread of the OpenMP team. The previous mode is
 // restored afterwards, so code around a step computes as before. Every force of an explicit
 // run is computed in this mode (the step, the first forces, a restored state's, reevaluate):
-// a restart recomputes exactly the bits the uninterrupted run had.
+// a restart recomputes exactly the bits the uninterrupted run had. The guard is on the whole
+// step rather than inside TlsphForces::compute because the kicks make them too (half a step
+// times a tiny acceleration).
 #pragma once
 
 #if defined(__SSE2__) || defined(_M_X64)
