@@ -1,10 +1,12 @@
 #!/bin/bash
 # Side-by-side throughput of LAMMPS's MACHDYN (pair smd/tlsph) and build/tlsph_bench on the same
 # 3D cantilever (benchmarks/bench_cantilever.cpp; issue 12). Needs a LAMMPS built from source with
-# the MACHDYN package (not a tlsph dependency). Prints particle-steps/s = atoms x steps / loop time.
-# Written from LAMMPS's documentation, examples and sources (cited below); the development machine
-# has no LAMMPS, so the generated input has not been run there.
+# the MACHDYN package (not a tlsph dependency; Debian's lammps package lacks it):
+# benchmarks/build_machdyn.sh builds one from Debian's LAMMPS source and prints its path.
+# Prints particle-steps/s = atoms x steps / loop time. Written from LAMMPS's documentation,
+# examples and sources (cited below); numbers from it are in docs/performance.md.
 # Usage: benchmarks/machdyn_side_by_side.sh LMP_BINARY [dx] [steps] [procs...]
+#   e.g. benchmarks/machdyn_side_by_side.sh "$(benchmarks/build_machdyn.sh)" 0.0125 2000
 #   defaults: dx 0.0125 (5,312 particles), steps 200, procs "1 2" (MACHDYN: MPI ranks, one
 #   OpenMP thread each; tlsph: OpenMP threads, one process). Issue 12's sizes: 0.0125 2000 and
 #   0.00625 200. Environment: MPIRUN (default mpirun), HG (both codes' hourglass coefficient,
@@ -29,12 +31,13 @@
 # -g t^2 / 2 with t = (steps + 1) dt in both (scale by the dt ratio); no accuracy comparison.
 set -u
 cd "$(dirname "$0")/.."
-[ $# -ge 1 ] || { sed -n 5,9p "$0"; exit 2; }
+[ $# -ge 1 ] || { sed -n 8,12p "$0"; exit 2; }
 LMP=$1; [[ $LMP == */* ]] && LMP=$(readlink -f "$LMP")
 command -v "$LMP" >/dev/null || { echo "no LAMMPS binary at $1" >&2; exit 2; }
 dx=${2:-0.0125}; steps=${3:-200}; shift $(($# < 3 ? $# : 3)); procs=${*:-1 2}
 MPIRUN=${MPIRUN:-mpirun}; HG=${HG:-10}; CFL=${CFL:-0.3}; support=2.1
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1  # as benchmarks/scaling.sh
+export OMPI_MCA_btl_vader_single_copy_mechanism=none
 # Lattice counts as in bench_cantilever.cpp (lround, ceil) and the CFL step dt = CFL dx / c.
 read -r nx ny layers dt < <(awk -v dx="$dx" -v s="$support" -v cfl="$CFL" 'BEGIN {
   E = 1e7; nu = 0.3; rho = 1000; lambda = E*nu/((1+nu)*(1-2*nu)); G = E/(2*(1+nu))
