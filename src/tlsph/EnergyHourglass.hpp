@@ -10,6 +10,7 @@
 
 #include <vector>
 
+#include "tlsph/Prefetch.hpp"
 #include "tlsph/ReferenceConfiguration.hpp"
 #include "tlsph/ReproducibleSum.hpp"
 #include "tlsph/Types.hpp"
@@ -58,6 +59,8 @@ class EnergyHourglass {
       Mat<D> moment = Mat<D>::Zero();
       for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
         const Index j = nb.neighbour[k];
+        prefetchAhead(&ref_.separation[k]);
+        prefetchAhead(&c_[k]);
         const Vec<D>& Xij = ref_.separation[k];
         const Vec<D> HjX = Gradient ? Vec<D>(F[j] * Xij) : Vec<D>(F[j] * Xij - Xij);
         const Vec<D> w = c_[k] * ((ui - u[j]) - 0.5 * HjX);

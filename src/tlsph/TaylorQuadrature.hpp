@@ -32,6 +32,7 @@
 #include "materials/Material.hpp"
 #include "tlsph/Communicator.hpp"
 #include "tlsph/OrderedSum.hpp"
+#include "tlsph/Prefetch.hpp"
 #include "tlsph/ReferenceConfiguration.hpp"
 #include "tlsph/Types.hpp"
 
@@ -93,6 +94,7 @@ class TaylorQuadrature {
       row.setZero();
     const Vec<D> ui = u[i];
     for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
+      prefetchAhead(&fit_[k]);
       const Vec<D> du = u[nb.neighbour[k]] - ui;
       const Fit& c = fit_[k];
       for (int a = 0; a < D; ++a)
@@ -130,7 +132,10 @@ class TaylorQuadrature {
   void gatherAll(Communicator& comm) { comm.gatherAll(G_); }
 
   Vec<D> hyperForceOwn(Index i) const { return R_[i] * sum_[i]; }
-  Vec<D> hyperForcePair(Index k, Index j) const { return R_[j] * reverse_[k]; }
+  Vec<D> hyperForcePair(Index k, Index j) const {
+    prefetchAhead(&reverse_[k]);
+    return R_[j] * reverse_[k];
+  }
 
   // Linearised: dstress[i] += dP^q_i and the linearised hyperstress force, for the direction v
   // (with dH its displacement gradient) about the state (F, G) of a force pass.

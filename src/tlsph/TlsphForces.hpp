@@ -24,6 +24,7 @@
 #include "tlsph/HourglassStiffness.hpp"
 #include "tlsph/OrderedSum.hpp"
 #include "tlsph/PairTerms.hpp"
+#include "tlsph/Prefetch.hpp"
 #include "tlsph/ReferenceConfiguration.hpp"
 #include "tlsph/TaylorQuadrature.hpp"
 #include "tlsph/Types.hpp"
@@ -247,8 +248,10 @@ class TlsphForces {
     const auto& nb = ref_.neighbours;
     const Vec<D> ui = u[i];
     Mat<D> gradU = Mat<D>::Zero();
-    for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k)
+    for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
+      prefetchAhead(&g[k]);
       gradU.noalias() += (u[nb.neighbour[k]] - ui) * g[k].transpose();
+    }
     return Mat<D>::Identity() + gradU;
   }
 
@@ -287,8 +290,10 @@ class TlsphForces {
       } else {
         const Vec<D> ui = u[i];
         gradU.setZero();
-        for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k)
+        for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
+          prefetchAhead(&ref_.correctedGradient[k]);
           gradU.noalias() += (u[nb.neighbour[k]] - ui) * ref_.correctedGradient[k].transpose();
+        }
       }
       const Mat<D> F = Mat<D>::Identity() + gradU;  // (6.69)
       F_[i] = F;
@@ -356,10 +361,15 @@ class TlsphForces {
       if constexpr (Taylor) internal += q->hyperForceOwn(i);  // through grad grad u
       for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
         const Index j = nb.neighbour[k];
+        prefetchAhead(&ref_.reverseGradient[k]);
         internal.noalias() -= S[j] * ref_.reverseGradient[k];
-        if constexpr (SeparateHourglassStress) internal.noalias() -= stress_[j] * linearReverse_[k];
+        if constexpr (SeparateHourglassStress) {
+          prefetchAhead(&linearReverse_[k]);
+          internal.noalias() -= stress_[j] * linearReverse_[k];
+        }
         if constexpr (Taylor) internal.noalias() -= q->hyperForcePair(k, j);
         if constexpr (Ganzenmueller || Viscous) {
+          prefetchAhead(&ref_.separation[k]);
           const Vec<D>& Xij = ref_.separation[k];
           const Vec<D> xij = Xij + (ui - u[j]);
           if constexpr (Ganzenmueller) hourglass += ganzenmueller_->pair(k, Xij, xij, Fh[i], Fh[j]);
