@@ -2,7 +2,8 @@
 // input must end in a scene or in one of the errors a user can act on (InputError, SetupError,
 // MaterialError), never in a crash, a hang or an unbounded allocation. Build and run with
 // `bash scripts/setup.sh fuzz` (clang, -fsanitize=fuzzer,address,undefined; seeds: examples/
-// and validation/scenes/). An input it reports goes to tests/fuzz-regressions/ (test_fuzz_regressions).
+// and validation/scenes/). An input it reports goes to tests/fuzz-regressions/
+// (test_fuzz_regressions).
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>

@@ -67,7 +67,7 @@ struct NewtonStatistics {
   // the multigrid, the coarsest level's (the fine K is never assembled).
   long nonZeros = 0;
   long factorNonZeros = 0;
-  int levels = 1;           // multigrid levels (1: the Cholesky factor of the whole matrix)
+  int levels = 1;  // multigrid levels (1: the Cholesky factor of the whole matrix)
   double assemblySeconds = 0.0, factorisationSeconds = 0.0, solveSeconds = 0.0;
   std::string linearSolver;
 };
