@@ -4,10 +4,10 @@
 // front to back, a particle's row of about 26-30 records at a time, while it gathers the
 // neighbours' values from cache. The hardware prefetchers alone left the passes waiting on
 // these streams both out of cache and from L3; asking for the line a fixed distance ahead,
-// once per record, measured +21-23 % per step at 41,728 particles and +8-11 % at 5,312 (scene
-// defaults, one thread, Intel Xeon model 167), with a broad optimum at 1.5-2 KB ahead (tried
-// 0.5-6 KB): about one particle's row of the widest (72 B) record. docs/performance.md has the
-// table.
+// once per record, measured +34-46 % per step at 41,728 particles and +0.5-14 % at 5,312 (both
+// corrections, 1 and 2 threads, Intel Xeon model 167), with a broad optimum at 1.5-2 KB ahead
+// (tried 0.5-6 KB): about one particle's row of the widest (72 B) record. docs/performance.md
+// has the tables.
 #pragma once
 
 #include <cstdint>
