@@ -11,8 +11,13 @@
 namespace tlsph {
 
 namespace {
-// This thread's number and the team's size (0 of 1 without OpenMP).
-std::pair<int, int> threadSlot() {
+// This thread's number and the team's size (0 of 1 without OpenMP). Plain variables, not a
+// structured binding: clang 14 (Debian's, which the fuzz build uses) cannot capture those in a
+// lambda.
+struct ThreadSlot {
+  int thread, threads;
+};
+ThreadSlot threadSlot() {
 #ifdef _OPENMP
   return {omp_get_thread_num(), omp_get_num_threads()};
 #else
@@ -104,7 +109,8 @@ const typename TangentStiffness<D>::SparseMatrix& TangentStiffness<D>::assemble(
   const Index nd = dofs_.size();
 #pragma omp parallel
   {
-    const auto [thread, threads] = threadSlot();
+    const ThreadSlot slot = threadSlot();
+    const int thread = slot.thread, threads = slot.threads;
     // Block columns [first, last): an equal share of the stored blocks.
     auto columnAt = [&](int t) {
       const Index target = blockStart_[nd] * t / threads;
@@ -176,7 +182,8 @@ std::vector<Mat<D>> TangentStiffness<D>::diagonalBlocks() const {
   // As in assemble(): each thread owns a range of unknowns and takes the particles in order.
 #pragma omp parallel
   {
-    const auto [thread, threads] = threadSlot();
+    const ThreadSlot slot = threadSlot();
+    const int thread = slot.thread, threads = slot.threads;
     const Index first = nd * thread / threads, last = nd * (thread + 1) / threads;
     Stencil s;
     Eigen::MatrixXd C;
