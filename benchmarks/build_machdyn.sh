@@ -4,7 +4,8 @@
 # Debian's `lammps` package is built without MACHDYN, so this takes the source Debian ships
 # (LAMMPS stable 7 Jan 2022, the bookworm package 20220106.git7586adbb6a+ds1, MACHDYN included),
 # checks it against the checksum in Debian's .dsc, and builds only the core and MACHDYN with MPI
-# and the flags tlsph uses (-O3 -march=native). About 5 minutes on 2 cores, 80 MB download.
+# and the flags tlsph uses (-O3 -march=native). About 2.5 minutes on the 2-core Intel development
+# machine, an 80 MB download.
 # Usage: benchmarks/build_machdyn.sh [DIR]   (default build/machdyn; prints the lmp binary's path)
 # Needs: cmake, g++, libeigen3-dev, libopenmpi-dev (all installed by scripts/setup.sh), curl.
 set -eu
