@@ -15,6 +15,7 @@
 #include <memory>
 #include <vector>
 
+#include "tlsph/LargePageAllocator.hpp"
 #include "tlsph/Lattice.hpp"
 #include "tlsph/Solver.hpp"
 #ifdef TLSPH_HAVE_MPI
@@ -138,6 +139,15 @@ int main(int argc, char** argv) {
               << solver.partition().halo << " particles in all, imbalance "
               << solver.partition().imbalance << "\n";
   solver.step();  // warm-up
+  {
+    // Whether the kernel gave the per-pair arrays huge pages (LargePageAllocator.hpp): the
+    // rate depends on it by 5-25 % (docs/performance.md).
+    const auto& g = solver.reference().correctedGradient;
+    const auto map = largepages::mappingOf(g.data());
+    std::cout << "pair arrays: " << (map.advised ? "advised for huge pages" : "not advised")
+              << ", the gradient vectors' mapping " << map.hugePageBytes / 1048576 << " of "
+              << map.bytes / 1048576 << " MiB on huge pages\n";
+  }
 #ifdef TLSPH_HAVE_MPI
   if (comm) comm->barrier();
   const MpiCommunicator::Traffic halo0 = comm ? comm->haloTraffic() : MpiCommunicator::Traffic{},

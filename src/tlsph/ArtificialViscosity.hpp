@@ -52,8 +52,8 @@ class ArtificialViscosity {
 
  private:
   double h_, q1_, q2_;
-  std::vector<double> weight_;  // V_J rho_I rho_J / rho_IJ |W'(X_IJ)|
-  std::vector<double> speed_;   // c_IJ
+  PairArray<double> weight_;  // V_J rho_I rho_J / rho_IJ |W'(X_IJ)|
+  PairArray<double> speed_;   // c_IJ
 };
 
 }  // namespace tlsph

@@ -20,7 +20,7 @@ namespace tlsph {
 template <int D>
 class EnergyHourglass {
  public:
-  EnergyHourglass(const ReferenceConfiguration<D>& ref, std::vector<double> pairCoefficient,
+  EnergyHourglass(const ReferenceConfiguration<D>& ref, PairArray<double> pairCoefficient,
                   const std::vector<double>& volume)
       : ref_(ref),
         c_(std::move(pairCoefficient)),
@@ -110,7 +110,7 @@ class EnergyHourglass {
 
  private:
   const ReferenceConfiguration<D>& ref_;
-  std::vector<double> c_;
+  PairArray<double> c_;
   const std::vector<double>& volume_;
   std::vector<Vec<D>> spring_;
   std::vector<Vec<D>> sumCX_;   // sum_J c_IJ X_IJ

@@ -15,7 +15,7 @@ namespace tlsph {
 template <int D>
 class GanzenmuellerHourglass {
  public:
-  explicit GanzenmuellerHourglass(std::vector<double> pairCoefficient)
+  explicit GanzenmuellerHourglass(PairArray<double> pairCoefficient)
       : c_(std::move(pairCoefficient)) {}
 
   // The pair's contribution to f_I / V_I; F the linear-corrected deformation gradients.
@@ -26,7 +26,7 @@ class GanzenmuellerHourglass {
   }
 
  private:
-  std::vector<double> c_;
+  PairArray<double> c_;
 };
 
 }  // namespace tlsph

@@ -16,16 +16,16 @@
 namespace tlsph {
 
 template <int D>
-std::vector<double> hourglassPairCoefficients(const ReferenceConfiguration<D>& ref,
-                                              const std::vector<Material>& materials,
-                                              const std::vector<std::uint16_t>& materialOf,
-                                              const std::vector<double>& volume, double alpha,
-                                              const std::vector<std::uint8_t>& passive = {}) {
+PairArray<double> hourglassPairCoefficients(const ReferenceConfiguration<D>& ref,
+                                            const std::vector<Material>& materials,
+                                            const std::vector<std::uint16_t>& materialOf,
+                                            const std::vector<double>& volume, double alpha,
+                                            const std::vector<std::uint8_t>& passive = {}) {
   const auto& nb = ref.neighbours;
   std::vector<double> youngs(materials.size());
   for (std::size_t m = 0; m < materials.size(); ++m)
     youngs[m] = elasticConstants(materials[m]).youngsModulus;
-  std::vector<double> c(nb.pairCount());
+  PairArray<double> c(nb.pairCount());
   for (Index i = 0; i < ref.particleCount(); ++i)
     for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
       const Index j = nb.neighbour[k];
@@ -40,7 +40,7 @@ std::vector<double> hourglassPairCoefficients(const ReferenceConfiguration<D>& r
 // stable time step).
 template <int D>
 std::vector<double> hourglassParticleStiffness(const ReferenceConfiguration<D>& ref,
-                                               const std::vector<double>& c,
+                                               const PairArray<double>& c,
                                                const std::vector<double>& volume) {
   const auto& nb = ref.neighbours;
   std::vector<double> K(ref.particleCount(), 0.0);

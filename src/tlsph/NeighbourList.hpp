@@ -4,14 +4,15 @@
 
 #include <vector>
 
+#include "tlsph/LargePageAllocator.hpp"
 #include "tlsph/PeriodicBox.hpp"
 #include "tlsph/Types.hpp"
 
 namespace tlsph {
 
 struct NeighbourList {
-  std::vector<Index> offset;     // neighbours of I are neighbour[offset[I] .. offset[I+1])
-  std::vector<Index> neighbour;  // sorted ascending within each particle
+  std::vector<Index> offset;   // neighbours of I are neighbour[offset[I] .. offset[I+1])
+  PairArray<Index> neighbour;  // sorted ascending within each particle
 
   Index particleCount() const { return static_cast<Index>(offset.size()) - 1; }
   Index pairCount() const { return static_cast<Index>(neighbour.size()); }

@@ -53,18 +53,18 @@ template <int D>
 struct ReferenceConfiguration {
   NeighbourList neighbours;
   // Per pair (I, J), in CSR order:
-  std::vector<Vec<D>> separation;        // X_IJ = X_I - X_J (minimum image)
-  std::vector<Vec<D>> weightedGradient;  // w_IJ = V_J gradW_IJ
-  std::vector<double> kernelValue;       // W(X_IJ)
+  PairArray<Vec<D>> separation;        // X_IJ = X_I - X_J (minimum image)
+  PairArray<Vec<D>> weightedGradient;  // w_IJ = V_J gradW_IJ
+  PairArray<double> kernelValue;       // W(X_IJ)
   // g_IJ: grad f_I = sum_J (f_J - f_I) g_IJ, so F_I = 1 + sum_J (u_J - u_I) (x) g_IJ.
   // Linear correction: g_IJ = L_I^{-T} w_IJ.
-  std::vector<Vec<D>> correctedGradient;
+  PairArray<Vec<D>> correctedGradient;
   // Quadratic correction only: the linear g_IJ = L_I^{-T} w_IJ as well, for the hourglass
   // penalty's smooth field F_I X_IJ (with the quadratic F the penalty turns unstable).
-  std::vector<Vec<D>> linearGradient;
+  PairArray<Vec<D>> linearGradient;
   // t_IJ = (V_J / V_I) g_JI, the reverse pair's vector, so the force -dE/du_I is
   // V_I (P_I G_I - sum_J P_J t_IJ) with one pass over I's own list.
-  std::vector<Vec<D>> reverseGradient;
+  PairArray<Vec<D>> reverseGradient;
   // Per particle:
   std::vector<Mat<D>> correctionInverse;     // L_I^{-1}, (6.44)
   std::vector<Vec<D>> gradientSum;           // s_I = sum_J w_IJ
@@ -89,10 +89,10 @@ struct ReferenceConfiguration {
 // no list of its own gets zero.
 // valueOf(k): a_k for pair k (reversePairValuesOf, for values stored inside larger records).
 template <class Value, class ValueOf>
-std::vector<Value> reversePairValuesOf(const NeighbourList& nb, ValueOf&& valueOf,
-                                       const std::vector<double>& volume,
-                                       const std::vector<std::uint8_t>* hasRow = nullptr) {
-  std::vector<Value> t(nb.pairCount());
+PairArray<Value> reversePairValuesOf(const NeighbourList& nb, ValueOf&& valueOf,
+                                     const std::vector<double>& volume,
+                                     const std::vector<std::uint8_t>* hasRow = nullptr) {
+  PairArray<Value> t(nb.pairCount());
   const Index n = nb.particleCount();
   bool symmetric = true;
 #pragma omp parallel for reduction(&& : symmetric) schedule(static)
@@ -116,18 +116,18 @@ std::vector<Value> reversePairValuesOf(const NeighbourList& nb, ValueOf&& valueO
   return t;
 }
 
-template <class Value>
-std::vector<Value> reversePairValues(const NeighbourList& nb, const std::vector<Value>& a,
-                                     const std::vector<double>& volume,
-                                     const std::vector<std::uint8_t>* hasRow = nullptr) {
+template <class Value, class Allocator>
+PairArray<Value> reversePairValues(const NeighbourList& nb, const std::vector<Value, Allocator>& a,
+                                   const std::vector<double>& volume,
+                                   const std::vector<std::uint8_t>* hasRow = nullptr) {
   return reversePairValuesOf<Value>(
       nb, [&](Index k) -> const Value& { return a[k]; }, volume, hasRow);
 }
 
 template <int D>
-std::vector<Vec<D>> reverseVectors(const NeighbourList& nb, const std::vector<Vec<D>>& g,
-                                   const std::vector<double>& volume,
-                                   const std::vector<std::uint8_t>* hasRow = nullptr) {
+PairArray<Vec<D>> reverseVectors(const NeighbourList& nb, const PairArray<Vec<D>>& g,
+                                 const std::vector<double>& volume,
+                                 const std::vector<std::uint8_t>* hasRow = nullptr) {
   return reversePairValues(nb, g, volume, hasRow);
 }
 

@@ -175,13 +175,14 @@ class TangentStiffness {
   std::vector<std::vector<Index>> groups_;  // energy particles per material
   std::vector<std::uint8_t> hasEnergy_;
   std::vector<Modulus> modulus_;
-  std::vector<double> c_;
+  PairArray<double> c_;  // the penalty's c_IJ
   std::unique_ptr<EnergyHourglass<D>> penalty_;
   std::unique_ptr<TaylorQuadrature<D>> quadrature_;
   std::vector<Mat<D>> quadratureF_;
   std::vector<typename TaylorQuadrature<D>::SymMatrix> quadratureG_;
-  bool separate_ = false;  // the penalty compares with the linear F (its own vectors)
-  std::vector<Vec<D>> linearReverse_, linearSum_;
+  bool separate_ = false;            // the penalty compares with the linear F (its own vectors)
+  PairArray<Vec<D>> linearReverse_;  // t^lin_IJ
+  std::vector<Vec<D>> linearSum_;    // G^lin_I
   std::vector<Mat<D>> hourglassH_, penaltyStress_;
   std::vector<Vec<D>> full_, df_;
   std::vector<Mat<D>> dF_, dS_;  // per particle: dH = dF and A : dH

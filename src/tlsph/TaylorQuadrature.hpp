@@ -225,8 +225,9 @@ class TaylorQuadrature {
 
   const ReferenceConfiguration<D>& ref_;
   const std::vector<double>& volume_;
-  std::vector<Fit> fit_;            // [g_IJ, S_IJ]
-  std::vector<Sym> reverse_, sum_;  // T_IJ = (V_J / V_I) S_JI, sum_J S_IJ
+  PairArray<Fit> fit_;      // [g_IJ, S_IJ]
+  PairArray<Sym> reverse_;  // T_IJ = (V_J / V_I) S_JI
+  std::vector<Sym> sum_;    // sum_J S_IJ
   std::vector<double> weight_, lambda_, mu_;
   std::vector<std::uint8_t> smallStrain_;  // linear-elastic material: e_a = sym(G_a)
   std::vector<SymMatrix> G_;               // grad grad u, symmetric storage

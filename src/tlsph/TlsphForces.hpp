@@ -244,7 +244,7 @@ class TlsphForces {
  private:
   // F_I = 1 + sum_J (u_J - u_I) (x) g_IJ (6.69), for the gradient vectors g given.
   Mat<D> deformationGradientOf(Index i, const std::vector<Vec<D>>& u,
-                               const std::vector<Vec<D>>& g) const {
+                               const PairArray<Vec<D>>& g) const {
     const auto& nb = ref_.neighbours;
     const Vec<D> ui = u[i];
     Mat<D> gradU = Mat<D>::Zero();
@@ -403,8 +403,9 @@ class TlsphForces {
   std::vector<Index> passive_;
   std::vector<Mat<D>> F_;
   std::vector<Mat<D>> P_;
-  std::vector<Mat<D>> stress_;  // P + P^hg (energy form only; P^hg alone on the linear F)
-  std::vector<Vec<D>> linearReverse_, linearSum_;  // t^lin_IJ, G^lin_I (that case only)
+  std::vector<Mat<D>> stress_;       // P + P^hg (energy form only; P^hg alone on the linear F)
+  PairArray<Vec<D>> linearReverse_;  // t^lin_IJ (that case only)
+  std::vector<Vec<D>> linearSum_;    // G^lin_I
   bool separateHourglassGradient_ = false;
   std::vector<Mat<D>> hourglassF_;
   std::vector<double> hourglassStiffness_;  // K_I
