@@ -1,7 +1,9 @@
 // The per-pair arrays' storage (LargePageAllocator.hpp, issue 12): a block of 2 MiB or more
 // starts on a 2 MiB boundary in a mapping advised for huge pages, smaller blocks keep their
 // type's alignment, and the arrays behave as vectors (growth across the threshold, copies,
-// moves). That the kernel then backs them with huge pages is its choice (printed, not asserted).
+// moves); the reference configuration's per-pair arrays and the per-particle arrays the pair
+// loops gather live in such blocks. That the kernel then backs them with huge pages is its
+// choice (printed, not asserted).
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -100,4 +102,21 @@ TEST(LargePages, ReferenceConfigurationsPairArraysAreAdvised) {
     EXPECT_TRUE(alignedTo(p, largepages::kHugePageBytes));
   if (!kernelHasHugePages()) GTEST_SKIP() << "no transparent huge pages in this kernel";
   EXPECT_TRUE(largepages::mappingOf(ref.correctedGradient.data()).advised);
+}
+
+// So do the per-particle arrays the pair loops gather at the neighbours' indices (F here).
+TEST(LargePages, GatheredParticleArraysAreAdvised) {
+  const double dx = 0.01;
+  const auto X = cellCentredLattice<3>(Vec3::Zero(), {32, 32, 32}, dx);  // F: 2.4 MB
+  const std::vector<double> volume(X.size(), dx * dx * dx);
+  const auto ref =
+      buildReferenceConfiguration<3>(X, volume, Kernel<3>(KernelType::WendlandC2, 2.1 * dx));
+  const std::vector<Material> materials{testMaterial("neo-hookean")};
+  const std::vector<std::uint16_t> materialOf(X.size(), 0);
+  TlsphForces<3> forces(ref, materials, materialOf, volume, HourglassSettings{});
+  const auto& F = forces.deformationGradient();
+  ASSERT_GE(F.size() * sizeof(Mat3), largepages::kHugePageBytes);
+  EXPECT_TRUE(alignedTo(F.data(), largepages::kHugePageBytes));
+  if (!kernelHasHugePages()) GTEST_SKIP() << "no transparent huge pages in this kernel";
+  EXPECT_TRUE(largepages::mappingOf(F.data()).advised);
 }

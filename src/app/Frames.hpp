@@ -5,6 +5,7 @@
 #include <algorithm>
 
 #include <cmath>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -18,7 +19,7 @@ namespace tlsph {
 // the pair's current separation and the one F predicts; large where hourglass modes grow.
 template <int D>
 std::vector<double> hourglassError(const ReferenceConfiguration<D>& ref,
-                                   const std::vector<Vec<D>>& u, const std::vector<Mat<D>>& F,
+                                   const std::vector<Vec<D>>& u, std::span<const Mat<D>> F,
                                    const std::vector<Index>* particles = nullptr) {
   const auto& nb = ref.neighbours;
   std::vector<double> out(ref.particleCount(), 0.0);

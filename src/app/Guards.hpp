@@ -139,7 +139,7 @@ class RunGuard {
     for (const auto& load : setup.scene.loads)
       for (Index i : load.particles)
         near_[i] |= kLoad;
-    save(scanState(p, solver.forces().deformationGradient(), setup.ghost), initial_);
+    save(scanState<D>(p, solver.forces().deformationGradient(), setup.ghost), initial_);
   }
 
   GuardState state() const { return {initial_, total0_, scale_, previousSpeed_}; }
@@ -150,7 +150,7 @@ class RunGuard {
     initial_ = g.initial;
     total0_ = g.total0;
     scale_ = g.scale;
-    save(scanState(setup_.scene.particles, solver_.forces().deformationGradient(), setup_.ghost),
+    save(scanState<D>(setup_.scene.particles, solver_.forces().deformationGradient(), setup_.ghost),
          solver_.energyBalance());
     previousSpeed_ = g.previousSpeed;
   }
@@ -162,7 +162,7 @@ class RunGuard {
     solver_.synchronize();
     const auto& p = setup_.scene.particles;
     const auto& F = solver_.forces().deformationGradient();
-    const StateScan s = scanState(p, F, setup_.ghost);
+    const StateScan s = scanState<D>(p, F, setup_.ghost);
     const EnergyBalance e = solver_.energyBalance();
     const bool finiteBooks = booksFinite(e);
     if (finiteBooks) scale_ = std::max(scale_, bookMagnitude(e));

@@ -195,7 +195,8 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
                                momentum.x(),   momentum.y(),
                                momentum.z()};
     if (out.hourglassContent) {
-      std::vector<Mat<D>> H = solver.forces().deformationGradient();
+      const auto& F = solver.forces().deformationGradient();
+      std::vector<Mat<D>> H(F.begin(), F.end());
       for (auto& h : H)
         h -= Mat<D>::Identity();
       row.push_back(hourglassContent(solver.reference(), p.volume, p.displacement, H,

@@ -38,14 +38,14 @@ class Communicator {
   virtual void barrier() = 0;
 
   // Entries of the halo: set to the owners' values; other entries are left as they were.
-  template <class T>
-  void exchangeHalo(std::vector<T>& values) {
+  template <class T, class A>
+  void exchangeHalo(std::vector<T, A>& values) {
     static_assert(std::is_trivially_destructible_v<T>);  // plain numbers, Eigen fixed-size
     if (!values.empty()) exchangeHaloBytes(reinterpret_cast<char*>(values.data()), sizeof(T));
   }
   // Every entry set to its owner's value.
-  template <class T>
-  void gatherAll(std::vector<T>& values) {
+  template <class T, class A>
+  void gatherAll(std::vector<T, A>& values) {
     static_assert(std::is_trivially_destructible_v<T>);  // plain numbers, Eigen fixed-size
     if (!values.empty()) gatherAllBytes(reinterpret_cast<char*>(values.data()), sizeof(T));
   }

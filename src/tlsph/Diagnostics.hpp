@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <span>
 #include <vector>
 
 #include "tlsph/OrderedSum.hpp"
@@ -116,7 +117,7 @@ struct StateScan {
 // flagged in `skip` (clamp ghosts; empty: none skipped) and the largest speed. Ties go to the
 // lower index, so the result does not depend on the thread count.
 template <int D>
-StateScan scanState(const ParticleSet<D>& p, const std::vector<Mat<D>>& F,
+StateScan scanState(const ParticleSet<D>& p, std::span<const Mat<D>> F,
                     const std::vector<std::uint8_t>& skip) {
   StateScan total;
   const Index n = p.size();

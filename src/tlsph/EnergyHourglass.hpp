@@ -8,6 +8,7 @@
 // an F exact for quadratic fields it is zero for quadratic fields too.
 #pragma once
 
+#include <span>
 #include <vector>
 
 #include "tlsph/Prefetch.hpp"
@@ -45,9 +46,8 @@ class EnergyHourglass {
   // tangent's linearised pass, where 1 + dH would round dH off).
   // `particles`: only these (a distributed run's own), else all.
   template <bool Gradient = false>
-  void evaluate(const std::vector<Vec<D>>& u, const std::vector<Mat<D>>& F,
-                const std::vector<Mat<D>>* P, std::vector<Mat<D>>& stress,
-                const std::vector<Index>* particles = nullptr) {
+  void evaluate(const std::vector<Vec<D>>& u, std::span<const Mat<D>> F, const Mat<D>* P,
+                std::span<Mat<D>> stress, const std::vector<Index>* particles = nullptr) {
     const auto& nb = ref_.neighbours;
     const Index count = particles ? static_cast<Index>(particles->size()) : ref_.particleCount();
     const Index* list = particles ? particles->data() : nullptr;
@@ -73,7 +73,7 @@ class EnergyHourglass {
       // P + P^hg, written as expressions: a Mat = Mat copy here is an out-of-line call once
       // the unit holds enough of them, and that spills the loop's sums to memory
       if (P)
-        stress[i].noalias() = (*P)[i] - 0.5 * moment;
+        stress[i].noalias() = P[i] - 0.5 * moment;
       else
         stress[i].noalias() = -0.5 * moment;
       spring_[i] = -volume_[i] * sum;  // -sum_J k_IJ e_IJ
@@ -88,7 +88,7 @@ class EnergyHourglass {
   // E_hg = 1/4 sum_I V_I sum_J c_IJ |e_IJ|^2 for the displacements u and gradients F
   // (a diagnostic pass, not part of the force). Distributed: each rank its particles', summed
   // over the ranks with the same bits as a serial sum (ReproducibleSum.hpp).
-  double energy(const std::vector<Vec<D>>& u, const std::vector<Mat<D>>& F,
+  double energy(const std::vector<Vec<D>>& u, std::span<const Mat<D>> F,
                 const std::vector<Index>* particles = nullptr, Communicator* comm = nullptr) const {
     const auto& nb = ref_.neighbours;
     const Index count = particles ? static_cast<Index>(particles->size()) : ref_.particleCount();

@@ -1,4 +1,5 @@
-// Storage for the arrays the pair loops stream every step (issue 12): a block of 2 MiB or more
+// Storage for the arrays the pair loops stream every step (issue 12): the per-pair arrays
+// and the per-particle ones they gather at the neighbours' indices. A block of 2 MiB or more
 // is mapped on its own, aligned to 2 MiB and advised for transparent huge pages before it is
 // first touched, so the kernel backs it with 2 MiB pages where it can.
 // Why: the per-pair arrays (tens of MB at 10^4 particles, GB at 10^6) are streamed once per
@@ -58,8 +59,10 @@ struct LargePageAllocator {
   friend bool operator==(const LargePageAllocator&, const LargePageAllocator&) { return true; }
 };
 
+template <class T>
+using LargeArray = std::vector<T, LargePageAllocator<T>>;
 // A per-pair array (one entry per neighbour pair, in CSR order).
 template <class T>
-using PairArray = std::vector<T, LargePageAllocator<T>>;
+using PairArray = LargeArray<T>;
 
 }  // namespace tlsph

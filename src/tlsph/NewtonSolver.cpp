@@ -200,7 +200,7 @@ void NewtonSolver<D>::move(const Eigen::VectorXd& du, double s) {
 
 template <int D>
 bool NewtonSolver<D>::updateMultigrid(double t, const std::vector<Vec<D>>& u,
-                                      const std::vector<Mat<D>>& F,
+                                      std::span<const Mat<D>> F,
                                       const std::vector<typename TaylorQuadrature<D>::SymMatrix>& G,
                                       std::string& why) {
   const auto t0 = Clock::now();
@@ -209,7 +209,7 @@ bool NewtonSolver<D>::updateMultigrid(double t, const std::vector<Vec<D>>& u,
   statistics_.nonZeros = multigrid_->coarsestNonZeros();
   statistics_.factorNonZeros = multigrid_->coarsestFactorNonZeros();
   ++statistics_.factorisations;
-  factorDeformation_ = F;
+  factorDeformation_.assign(F.begin(), F.end());
   factorTime_ = t;
   factorDisplacement_ = u;
   factorSecondGradients_ = G;
@@ -230,7 +230,8 @@ bool NewtonSolver<D>::factorise(std::string& why) {
   statistics_.assemblySeconds += seconds(t0);
   t0 = Clock::now();
   factorised_ = factor_.factorise(K);
-  factorDeformation_ = solver_.forces().deformationGradient();
+  const auto& F = solver_.forces().deformationGradient();
+  factorDeformation_.assign(F.begin(), F.end());
   statistics_.factorisationSeconds += seconds(t0);
   statistics_.factorNonZeros = factor_.factorNonZeros();
   ++statistics_.factorisations;

@@ -13,6 +13,7 @@
 #include <cmath>
 #include <functional>
 #include <memory>
+#include <span>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -135,7 +136,7 @@ class NewtonSolver {
   // Drops the multigrid for the Cholesky factor (auto mode, after a stall), saying why.
   void useCholesky(const std::string& why);
   // Multigrid: the preconditioner at load time t, displacements u (F, second gradients G).
-  bool updateMultigrid(double t, const std::vector<Vec<D>>& u, const std::vector<Mat<D>>& F,
+  bool updateMultigrid(double t, const std::vector<Vec<D>>& u, std::span<const Mat<D>> F,
                        const std::vector<typename TaylorQuadrature<D>::SymMatrix>& G,
                        std::string& why);
   Eigen::VectorXd precondition(const Eigen::VectorXd& r) {

@@ -27,7 +27,7 @@ ThreadSlot threadSlot() {
 }  // namespace
 
 template <int D>
-void TangentStiffness<D>::update(const std::vector<Mat<D>>& F) {
+void TangentStiffness<D>::update(std::span<const Mat<D>> F) {
   for (std::size_t m = 0; m < materials_.size(); ++m)
     std::visit(
         [&](const auto& model) {
@@ -69,7 +69,7 @@ void TangentStiffness<D>::apply(const Eigen::VectorXd& v, Eigen::VectorXd& Kv, P
     if (separate_) {
       penalty_->template evaluate<true>(full_, hourglassH_, nullptr, penaltyStress_);
     } else {
-      penalty_->template evaluate<true>(full_, dF_, &dS_, penaltyStress_);
+      penalty_->template evaluate<true>(full_, dF_, dS_.data(), penaltyStress_);
       S = &penaltyStress_;
     }
   }

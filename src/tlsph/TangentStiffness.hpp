@@ -19,6 +19,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <variant>
 #include <vector>
 
@@ -102,19 +103,19 @@ class TangentStiffness {
 
   // The material tangents A_I = dP/dF at the deformation gradients F (every particle's; the
   // passive ones are not used).
-  void update(const std::vector<Mat<D>>& F);
+  void update(std::span<const Mat<D>> F);
   // The state of the quadrature correction (TaylorQuadrature; F and its second gradients from
   // the last force pass); the assembled matrix leaves that term out (a preconditioner then).
-  void updateQuadrature(const TaylorQuadrature<D>* q, const std::vector<Mat<D>>& F) {
+  void updateQuadrature(const TaylorQuadrature<D>* q, std::span<const Mat<D>> F) {
     if (!quadrature_ || !q) return;
-    quadratureF_ = F;
+    quadratureF_.assign(F.begin(), F.end());
     quadratureG_ = q->secondGradients();
   }
   // The same from saved second gradients (a restart).
   void updateQuadrature(const std::vector<typename TaylorQuadrature<D>::SymMatrix>& G,
-                        const std::vector<Mat<D>>& F) {
+                        std::span<const Mat<D>> F) {
     if (!quadrature_ || G.empty()) return;
-    quadratureF_ = F;
+    quadratureF_.assign(F.begin(), F.end());
     quadratureG_ = G;
   }
 

@@ -27,6 +27,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "materials/Material.hpp"
@@ -140,7 +141,7 @@ class TaylorQuadrature {
   // Linearised: dstress[i] += dP^q_i and the linearised hyperstress force, for the direction v
   // (with dH its displacement gradient) about the state (F, G) of a force pass.
   void linearise(const std::vector<Vec<D>>& v, const std::vector<Mat<D>>& dH,
-                 const std::vector<Mat<D>>& F, const std::vector<SymMatrix>& Gs,
+                 std::span<const Mat<D>> F, const std::vector<SymMatrix>& Gs,
                  std::vector<Mat<D>>& dstress) {
     const Index n = ref_.particleCount();
 #pragma omp parallel for schedule(static)
@@ -180,7 +181,7 @@ class TaylorQuadrature {
   }
 
   // E_q at the state of the last force pass.
-  double energy(const std::vector<Mat<D>>& F) const {
+  double energy(std::span<const Mat<D>> F) const {
     return orderedSum(ref_.particleCount(), [&](Index i) {
       if (weight_[i] == 0.0) return 0.0;
       double e = 0.0;
@@ -211,7 +212,7 @@ class TaylorQuadrature {
     return Rs;
   }
 
-  void hyperForce(const std::vector<SymMatrix>& R) {
+  void hyperForce(std::span<const SymMatrix> R) {
     const auto& nb = ref_.neighbours;
     const Index n = ref_.particleCount();
 #pragma omp parallel for schedule(static)
@@ -231,7 +232,7 @@ class TaylorQuadrature {
   std::vector<double> weight_, lambda_, mu_;
   std::vector<std::uint8_t> smallStrain_;  // linear-elastic material: e_a = sym(G_a)
   std::vector<SymMatrix> G_;               // grad grad u, symmetric storage
-  std::vector<SymMatrix> R_;               // hyperstress, symmetric storage
+  LargeArray<SymMatrix> R_;                // hyperstress, symmetric storage (gathered)
   std::vector<Vec<D>> force_;
 };
 

@@ -135,13 +135,13 @@ class TlsphForces {
     if (comm_ && hourglass_.enabled())
       comm_->exchangeHalo(separateHourglassGradient_ ? hourglassF_ : F_);
     // What the force pass sends through g_IJ: P (+ P^q) (+ P^hg of the same F).
-    const std::vector<Mat<D>>& PQ = quadrature_ ? quadratureStress_ : P_;
+    const LargeArray<Mat<D>>& PQ = quadrature_ ? quadratureStress_ : P_;
     const std::vector<Index>* owned = comm_ ? &owned_ : nullptr;
     // P^hg of the linear F goes through the linear gradient vectors: its own sum.
     if (energyHourglass_ && separateHourglassGradient_)
       energyHourglass_->evaluate(u, hourglassF_, nullptr, stress_, owned);
     else if (energyHourglass_)
-      energyHourglass_->evaluate(u, F_, &PQ, stress_, owned);
+      energyHourglass_->evaluate(u, F_, PQ.data(), stress_, owned);
     if (comm_) {  // the force pass reads the neighbours' stresses (and hyperstresses)
       if (energyHourglass_) comm_->exchangeHalo(stress_);
       if (!energyHourglass_ || separateHourglassGradient_)
@@ -155,7 +155,7 @@ class TlsphForces {
       forcePass<false>(u, f, v, viscous);
   }
 
-  const std::vector<Mat<D>>& deformationGradient() const { return F_; }
+  const LargeArray<Mat<D>>& deformationGradient() const { return F_; }
   // The textbook hourglass part of the last computed force (empty for the energy form and
   // when the term is off); the solver integrates its work.
   const std::vector<Vec<D>>& hourglassForce() const { return hourglassForce_; }
@@ -345,10 +345,10 @@ class TlsphForces {
     const Index* owned = comm_ ? owned_.data() : nullptr;
     // The stress the force pass sends through the gradient vectors: P (+ P^q), or that plus
     // P^hg (or P^hg alone through the linear vectors).
-    const std::vector<Mat<D>>& S = energyHourglass_ && !SeparateHourglassStress ? stress_
-                                   : Taylor                                     ? quadratureStress_
-                                                                                : P_;
-    const std::vector<Mat<D>>& Fh = separateHourglassGradient_ ? hourglassF_ : F_;
+    const LargeArray<Mat<D>>& S = energyHourglass_ && !SeparateHourglassStress ? stress_
+                                  : Taylor                                     ? quadratureStress_
+                                                                               : P_;
+    const LargeArray<Mat<D>>& Fh = separateHourglassGradient_ ? hourglassF_ : F_;
     [[maybe_unused]] const TaylorQuadrature<D>* q = quadrature_.get();
 #pragma omp parallel for schedule(static)
     for (Index p = 0; p < count; ++p) {
@@ -401,17 +401,18 @@ class TlsphForces {
   HourglassSettings hourglass_;
   std::vector<std::vector<Index>> particlesOfMaterial_;  // without the passive particles
   std::vector<Index> passive_;
-  std::vector<Mat<D>> F_;
-  std::vector<Mat<D>> P_;
-  std::vector<Mat<D>> stress_;       // P + P^hg (energy form only; P^hg alone on the linear F)
+  // Per particle, gathered by the pair loops at the neighbours' indices: huge pages as well.
+  LargeArray<Mat<D>> F_;
+  LargeArray<Mat<D>> P_;
+  LargeArray<Mat<D>> stress_;        // P + P^hg (energy form only; P^hg alone on the linear F)
   PairArray<Vec<D>> linearReverse_;  // t^lin_IJ (that case only)
   std::vector<Vec<D>> linearSum_;    // G^lin_I
   bool separateHourglassGradient_ = false;
-  std::vector<Mat<D>> hourglassF_;
+  LargeArray<Mat<D>> hourglassF_;
   std::vector<double> hourglassStiffness_;  // K_I
   std::unique_ptr<EnergyHourglass<D>> energyHourglass_;
   std::unique_ptr<TaylorQuadrature<D>> quadrature_;
-  std::vector<Mat<D>> quadratureStress_;  // P + P^q
+  LargeArray<Mat<D>> quadratureStress_;  // P + P^q
   std::unique_ptr<GanzenmuellerHourglass<D>> ganzenmueller_;
   std::unique_ptr<ArtificialViscosity<D>> viscosity_;
   std::vector<Vec<D>> hourglassForce_;
