@@ -140,8 +140,8 @@ int main(int argc, char** argv) {
               << solver.partition().imbalance << "\n";
   solver.step();  // warm-up
   {
-    // Whether the kernel gave the per-pair arrays huge pages (LargePageAllocator.hpp): the
-    // rate depends on it by 5-25 % (docs/performance.md).
+    // Whether the kernel gave the per-pair arrays huge pages (LargePageAllocator.hpp): on the
+    // Intel machine the rate depended on it by 0-17 % (docs/performance.md).
     const auto& g = solver.reference().correctedGradient;
     const auto map = largepages::mappingOf(g.data());
     std::cout << "pair arrays: " << (map.advised ? "advised for huge pages" : "not advised")

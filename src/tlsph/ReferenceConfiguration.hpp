@@ -116,8 +116,8 @@ PairArray<Value> reversePairValuesOf(const NeighbourList& nb, ValueOf&& valueOf,
   return t;
 }
 
-template <class Value, class Allocator>
-PairArray<Value> reversePairValues(const NeighbourList& nb, const std::vector<Value, Allocator>& a,
+template <class Value>
+PairArray<Value> reversePairValues(const NeighbourList& nb, const PairArray<Value>& a,
                                    const std::vector<double>& volume,
                                    const std::vector<std::uint8_t>* hasRow = nullptr) {
   return reversePairValuesOf<Value>(
