@@ -168,7 +168,8 @@ int main(int argc, char** argv) {
   const auto traffic = solver.forces().traffic();
   const double pairsPerParticle = double(nb.pairCount()) / nb.particleCount();
   const double bytes = traffic.perPair * pairsPerParticle + traffic.perParticle;
-  std::cout << "traffic (counted, force passes) " << traffic.perPair << " B per pair + "
+  std::cout << "traffic (counted, force passes) " << traffic.perPair << " B per pair ("
+            << traffic.unsharedPerPair << " with every particle's rows stored) + "
             << traffic.perParticle << " B per particle = " << bytes / 1e3
             << " kB per particle-step; reached " << rate * bytes / 1e9 << " GB/s";
   if (stream && ranks == 1) {

@@ -9,11 +9,13 @@
 #pragma once
 
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "tlsph/Prefetch.hpp"
 #include "tlsph/ReferenceConfiguration.hpp"
 #include "tlsph/ReproducibleSum.hpp"
+#include "tlsph/SharedRows.hpp"
 #include "tlsph/Types.hpp"
 
 namespace tlsph {
@@ -24,17 +26,21 @@ class EnergyHourglass {
   EnergyHourglass(const ReferenceConfiguration<D>& ref, PairArray<double> pairCoefficient,
                   const std::vector<double>& volume)
       : ref_(ref),
-        c_(std::move(pairCoefficient)),
         volume_(volume),
         spring_(ref.particleCount(), Vec<D>::Zero()),
         sumCX_(ref.particleCount(), Vec<D>::Zero()),
         sumCXX_(ref.particleCount(), Mat<D>::Zero()) {
     const auto& nb = ref.neighbours;
+    const PairArray<double>& c = pairCoefficient;
     for (Index i = 0; i < ref.particleCount(); ++i)
       for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
-        sumCX_[i] += c_[k] * ref.separation[k];
-        sumCXX_[i] += c_[k] * ref.separation[k] * ref.separation[k].transpose();
+        sumCX_[i] += c[k] * ref.separation[k];
+        sumCXX_[i] += c[k] * ref.separation[k] * ref.separation[k].transpose();
       }
+    // The pass streams only the distinct rows (SharedRows.hpp; X_IJ from the reference's
+    // array unless sharing halves it).
+    c_ = SharedRows<double>(nb, std::move(pairCoefficient));
+    separation_ = SharedRows<Vec<D>>(nb, ref.separation);
   }
 
   // One pass over the pairs: stress[i] = P[i] + P^hg_i (what the force pass uses; P^hg_i
@@ -57,13 +63,15 @@ class EnergyHourglass {
       const Vec<D> ui = u[i];
       Vec<D> sum = Vec<D>::Zero();
       Mat<D> moment = Mat<D>::Zero();
-      for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
+      const Vec<D>* X = separation_.row(i);
+      const double* c = c_.row(i);
+      for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k, ++X, ++c) {
         const Index j = nb.neighbour[k];
-        prefetchAhead(&ref_.separation[k]);
-        prefetchAhead(&c_[k]);
-        const Vec<D>& Xij = ref_.separation[k];
+        prefetchAhead(X);
+        prefetchAhead(c);
+        const Vec<D>& Xij = *X;
         const Vec<D> HjX = Gradient ? Vec<D>(F[j] * Xij) : Vec<D>(F[j] * Xij - Xij);
-        const Vec<D> w = c_[k] * ((ui - u[j]) - 0.5 * HjX);
+        const Vec<D> w = *c * ((ui - u[j]) - 0.5 * HjX);
         sum += w;
         moment.noalias() += w * Xij.transpose();
       }
@@ -78,6 +86,11 @@ class EnergyHourglass {
         stress[i].noalias() = -0.5 * moment;
       spring_[i] = -volume_[i] * sum;  // -sum_J k_IJ e_IJ
     }
+  }
+
+  // The bytes of the per-pair rows the pass streams (X_IJ and c_IJ, each distinct row once).
+  double storedPairBytes() const {
+    return separation_.storedBytes() + c_.storedBytes();
   }
 
   // Spring part of the force on particle i from the last evaluate().
@@ -97,11 +110,13 @@ class EnergyHourglass {
     for (Index p = 0; p < count; ++p) {
       const Index i = particles ? (*particles)[p] : p;
       double squares = 0.0;
-      for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
+      const Vec<D>* X = separation_.row(i);
+      const double* c = c_.row(i);
+      for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k, ++X, ++c) {
         const Index j = nb.neighbour[k];
-        const Vec<D>& Xij = ref_.separation[k];
+        const Vec<D>& Xij = *X;
         const Vec<D> e = (u[i] - u[j]) - 0.5 * ((F[i] + F[j]) * Xij - 2.0 * Xij);
-        squares += c_[k] * e.squaredNorm();
+        squares += *c * e.squaredNorm();
       }
       terms[p] = 0.25 * volume_[i] * squares;
     }
@@ -110,7 +125,8 @@ class EnergyHourglass {
 
  private:
   const ReferenceConfiguration<D>& ref_;
-  PairArray<double> c_;
+  SharedRows<double> c_;           // c_IJ
+  SharedRows<Vec<D>> separation_;  // X_IJ
   const std::vector<double>& volume_;
   std::vector<Vec<D>> spring_;
   std::vector<Vec<D>> sumCX_;   // sum_J c_IJ X_IJ

@@ -19,9 +19,11 @@ TaylorQuadrature<D>::TaylorQuadrature(const ReferenceConfiguration<D>& ref,
     : ref_(ref), volume_(volume) {
   const auto& nb = ref.neighbours;
   const Index n = ref.particleCount();
-  fit_.resize(nb.pairCount());
-  for (std::size_t k = 0; k < fit_.size(); ++k)  // S_IJ = 0 unless the fit below sets it
-    fit_[k] << ref.correctedGradient[k].transpose(), Sym::Zero().transpose();
+  // Built whole, then kept as shared rows (SharedRows.hpp): the pair loops stream only the
+  // distinct rows.
+  PairArray<Fit> fit(nb.pairCount());
+  for (std::size_t k = 0; k < fit.size(); ++k)  // S_IJ = 0 unless the fit below sets it
+    fit[k] << ref.correctedGradient[k].transpose(), Sym::Zero().transpose();
   sum_.assign(n, Sym::Zero());
   weight_.assign(n, 0.0);
   lambda_.assign(n, 0.0);
@@ -66,14 +68,16 @@ TaylorQuadrature<D>::TaylorQuadrature(const ReferenceConfiguration<D>& ref,
           const double v = c[D + t] / (l * l);
           s[t] = a == b ? 2.0 * v : v;  // S_IJ(a, b)
         }
-      fit_[k].template tail<P>() = s.transpose();
+      fit[k].template tail<P>() = s.transpose();
       sum_[i] += s;
     }
   }
   // T_IJ = (V_J / V_I) S_JI
-  reverse_ = reversePairValuesOf<Sym>(
-      nb, [&](Index k) -> Sym { return fit_[k].template tail<P>().transpose(); }, volume,
+  PairArray<Sym> reverse = reversePairValuesOf<Sym>(
+      nb, [&](Index k) -> Sym { return fit[k].template tail<P>().transpose(); }, volume,
       ref.rows());
+  fit_ = SharedRows<Fit>(nb, std::move(fit));
+  reverse_ = SharedRows<Sym>(nb, std::move(reverse));
   G_.assign(n, SymMatrix::Zero());
   R_.assign(n, SymMatrix::Zero());
   force_.assign(n, Vec<D>::Zero());

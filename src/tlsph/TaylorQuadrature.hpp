@@ -35,6 +35,7 @@
 #include "tlsph/OrderedSum.hpp"
 #include "tlsph/Prefetch.hpp"
 #include "tlsph/ReferenceConfiguration.hpp"
+#include "tlsph/SharedRows.hpp"
 #include "tlsph/Types.hpp"
 
 namespace tlsph {
@@ -62,8 +63,9 @@ class TaylorQuadrature {
     const auto& nb = ref_.neighbours;
     SymMatrix Gs = SymMatrix::Zero();
     const Vec<D> ui = u[i];
-    for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k)
-      Gs.noalias() += (u[nb.neighbour[k]] - ui) * fit_[k].template tail<P>();
+    const Fit* fit = fit_.row(i);
+    for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k, ++fit)
+      Gs.noalias() += (u[nb.neighbour[k]] - ui) * fit->template tail<P>();
     return unpack(Gs);
   }
 
@@ -94,10 +96,11 @@ class TaylorQuadrature {
     for (auto& row : rows)
       row.setZero();
     const Vec<D> ui = u[i];
-    for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
-      prefetchAhead(&fit_[k]);
+    const Fit* fit = fit_.row(i);
+    for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k, ++fit) {
+      prefetchAhead(fit);
       const Vec<D> du = u[nb.neighbour[k]] - ui;
-      const Fit& c = fit_[k];
+      const Fit& c = *fit;
       for (int a = 0; a < D; ++a)
         rows[a].noalias() += du[a] * c;
     }
@@ -133,9 +136,11 @@ class TaylorQuadrature {
   void gatherAll(Communicator& comm) { comm.gatherAll(G_); }
 
   Vec<D> hyperForceOwn(Index i) const { return R_[i] * sum_[i]; }
-  Vec<D> hyperForcePair(Index k, Index j) const {
-    prefetchAhead(&reverse_[k]);
-    return R_[j] * reverse_[k];
+  // Particle i's row of T_IJ (T[m] for its m-th pair), and one pair's term R_J . T_IJ.
+  const Sym* reverseRow(Index i) const { return reverse_.row(i); }
+  Vec<D> hyperForcePair(const Sym* T, Index j) const {
+    prefetchAhead(T);
+    return R_[j] * *T;
   }
 
   // Linearised: dstress[i] += dP^q_i and the linearised hyperstress force, for the direction v
@@ -180,6 +185,14 @@ class TaylorQuadrature {
     return G_;
   }
 
+  // The stored per-pair rows (SharedRows.hpp): the fit [g_IJ, S_IJ] and T_IJ.
+  const SharedRows<Fit>& fitRows() const {
+    return fit_;
+  }
+  const SharedRows<Sym>& reverseRows() const {
+    return reverse_;
+  }
+
   // E_q at the state of the last force pass.
   double energy(std::span<const Mat<D>> F) const {
     return orderedSum(ref_.particleCount(), [&](Index i) {
@@ -218,17 +231,18 @@ class TaylorQuadrature {
 #pragma omp parallel for schedule(static)
     for (Index i = 0; i < n; ++i) {
       Vec<D> f = R[i] * sum_[i];
-      for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k)
-        f.noalias() -= R[nb.neighbour[k]] * reverse_[k];
+      const Sym* T = reverse_.row(i);
+      for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k, ++T)
+        f.noalias() -= R[nb.neighbour[k]] * *T;
       force_[i] = volume_[i] * f;
     }
   }
 
   const ReferenceConfiguration<D>& ref_;
   const std::vector<double>& volume_;
-  PairArray<Fit> fit_;      // [g_IJ, S_IJ]
-  PairArray<Sym> reverse_;  // T_IJ = (V_J / V_I) S_JI
-  std::vector<Sym> sum_;    // sum_J S_IJ
+  SharedRows<Fit> fit_;      // [g_IJ, S_IJ]
+  SharedRows<Sym> reverse_;  // T_IJ = (V_J / V_I) S_JI
+  std::vector<Sym> sum_;     // sum_J S_IJ
   std::vector<double> weight_, lambda_, mu_;
   std::vector<std::uint8_t> smallStrain_;  // linear-elastic material: e_a = sym(G_a)
   std::vector<SymMatrix> G_;               // grad grad u, symmetric storage

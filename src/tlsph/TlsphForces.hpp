@@ -10,6 +10,7 @@
 // term that is off is not computed and the loops carry no branch on options.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <memory>
 #include <type_traits>
@@ -26,6 +27,7 @@
 #include "tlsph/PairTerms.hpp"
 #include "tlsph/Prefetch.hpp"
 #include "tlsph/ReferenceConfiguration.hpp"
+#include "tlsph/SharedRows.hpp"
 #include "tlsph/TaylorQuadrature.hpp"
 #include "tlsph/Types.hpp"
 
@@ -46,6 +48,11 @@ class TlsphForces {
         F_(reference.particleCount(), Mat<D>::Identity()),
         P_(reference.particleCount(), Mat<D>::Zero()) {
     const Index n = reference.particleCount();
+    // The pair loops stream only the distinct rows of the gradient vectors (SharedRows.hpp).
+    reverseGradient_ = SharedRows<Vec<D>>(reference.neighbours, reference.reverseGradient);
+    // (the Taylor fit holds g_IJ for the particles with a stress; passive ones read it here)
+    if (quadrature != Quadrature::Taylor || !passive.empty())
+      correctedGradient_ = SharedRows<Vec<D>>(reference.neighbours, reference.correctedGradient);
     particlesOfMaterial_.resize(materials.size());
     // Passive particles (mirrored ghosts) get an F but no stress and no strain energy.
     std::vector<std::uint8_t> isPassive;
@@ -72,7 +79,10 @@ class TlsphForces {
       const bool linearF = hourglass.form == HourglassForm::Ganzenmueller ||
                            hourglass.gradient == HourglassGradient::Linear;
       separateHourglassGradient_ = linearF && !reference.linearGradient.empty();
-      if (separateHourglassGradient_) hourglassF_.assign(n, Mat<D>::Identity());
+      if (separateHourglassGradient_) {
+        hourglassF_.assign(n, Mat<D>::Identity());
+        linearGradient_ = SharedRows<Vec<D>>(reference.neighbours, reference.linearGradient);
+      }
       if (hourglass.form == HourglassForm::Energy) {
         energyHourglass_ = std::make_unique<EnergyHourglass<D>>(reference, std::move(c), volume);
         stress_.assign(n, Mat<D>::Zero());
@@ -196,43 +206,73 @@ class TlsphForces {
   }
 
   // The memory traffic of one compute(), counted from the arrays the passes touch (issue 12's
-  // roofline): each per-pair array streamed once per pass that reads it, each per-particle
-  // array read or written once per pass; neighbours' values (u_J, F_J, S_J, R_J) assumed to
-  // hit the cache, so this is the compulsory traffic. Kept next to the loops it describes.
+  // roofline): each per-pair stream read once per pass that reads it, as stored (each distinct
+  // row once, SharedRows.hpp; averaged per pair), each per-particle array read or written once
+  // per pass; neighbours' values (u_J, F_J, S_J, R_J) assumed to hit the cache, so this is the
+  // compulsory traffic. unsharedPerPair: the same streams stored whole. Kept next to the loops
+  // it describes.
   struct Traffic {
-    double perPair = 0.0;      // bytes per neighbour pair
-    double perParticle = 0.0;  // bytes per particle
+    double perPair = 0.0;          // bytes per neighbour pair
+    double perParticle = 0.0;      // bytes per particle
+    double unsharedPerPair = 0.0;  // bytes per pair with every particle's rows stored
   };
   Traffic traffic() const {
     constexpr double I = sizeof(Index), V = sizeof(Vec<D>), M = sizeof(Mat<D>), d = sizeof(double);
-    const bool taylor = quadrature_ != nullptr;
+    const TaylorQuadrature<D>* q = quadrature_.get();
+    const bool taylor = q != nullptr;
     constexpr double S = sizeof(typename TaylorQuadrature<D>::Sym),
                      SM = sizeof(typename TaylorQuadrature<D>::SymMatrix);
+    const double pairs = std::max<double>(1.0, ref_.neighbours.pairCount());
     Traffic t;
+    // each shared stream: its stored bytes once, and a row start per particle
+    auto stream = [&](double storedBytes, double unsharedBytesPerPair) {
+      t.perPair += storedBytes / pairs;
+      t.unsharedPerPair += unsharedBytesPerPair;
+      t.perParticle += I;
+    };
+    auto pairIndices = [&] {  // j, streamed whole
+      t.perPair += I;
+      t.unsharedPerPair += I;
+    };
     // F pass: j and g_IJ (+ S_IJ); offset, group entry, u_I; writes F, P (+ P + P^q, the
     // second gradients and the hyperstress, reading the particle's three constants).
-    t.perPair += I + V + (taylor ? S : 0.0);
+    pairIndices();
+    if (taylor)
+      stream(q->fitRows().storedBytes(), V + S);
+    else
+      stream(correctedGradient_.storedBytes(), V);
     t.perParticle += 2 * I + V + 2 * M + (taylor ? M + 2 * SM + 3 * d : 0.0);
     if (separateHourglassGradient_) {  // the penalty's own F through g^lin_IJ
-      t.perPair += I + V;
+      pairIndices();
+      stream(linearGradient_.storedBytes(), V);
       t.perParticle += I + V + M;
     }
     if (energyHourglass_) {  // j, X_IJ, c_IJ; u_I, F_I, P_I, moments, V_I; writes P + P^hg, spring
-      t.perPair += I + V + d;
+      pairIndices();
+      stream(energyHourglass_->storedPairBytes(), V + d);
+      t.perParticle += I;  // the second row start
       t.perParticle += I + V + M + (separateHourglassGradient_ ? 0.0 : M) + M + V + V + M + d;
     }
     // Force pass: j, t_IJ (+ T_IJ) (+ t^lin_IJ); S_I, G_I (+ R_I, Sum_I), V_I; writes f.
-    t.perPair += I + V + (taylor ? S : 0.0) + (separateHourglassGradient_ ? V : 0.0);
+    pairIndices();
+    stream(reverseGradient_.storedBytes(), V);
+    if (taylor) stream(q->reverseRows().storedBytes(), S);
+    if (separateHourglassGradient_) stream(linearReverse_.storedBytes(), V);
     t.perParticle += I + M + V + (taylor ? SM + S : 0.0) + d + V;
     if (ganzenmueller_ || viscosity_) t.perParticle += V;    // u_I for x_IJ
     if (separateHourglassGradient_) t.perParticle += M + V;  // P^hg_I, G^lin_I
     if (energyHourglass_) t.perParticle += V;                // the spring force
+    // (the textbook form and the viscosity stream their per-pair arrays whole)
+    auto whole = [&](double bytes) {
+      t.perPair += bytes;
+      t.unsharedPerPair += bytes;
+    };
     if (ganzenmueller_) {  // X_IJ, c_IJ; F_I of the penalty; writes its force
-      t.perPair += V + d;
+      whole(V + d);
       t.perParticle += M + V;
     }
     if (viscosity_) {  // X_IJ (if not already), the pair's two coefficients; v_I; writes its force
-      t.perPair += (ganzenmueller_ ? 0.0 : V) + 2 * d;
+      whole((ganzenmueller_ ? 0.0 : V) + 2 * d);
       t.perParticle += 2 * V;
     }
     return t;
@@ -244,13 +284,14 @@ class TlsphForces {
  private:
   // F_I = 1 + sum_J (u_J - u_I) (x) g_IJ (6.69), for the gradient vectors g given.
   Mat<D> deformationGradientOf(Index i, const std::vector<Vec<D>>& u,
-                               const PairArray<Vec<D>>& g) const {
+                               const SharedRows<Vec<D>>& gradients) const {
     const auto& nb = ref_.neighbours;
     const Vec<D> ui = u[i];
     Mat<D> gradU = Mat<D>::Zero();
-    for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
-      prefetchAhead(&g[k]);
-      gradU.noalias() += (u[nb.neighbour[k]] - ui) * g[k].transpose();
+    const Vec<D>* g = gradients.row(i);
+    for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k, ++g) {
+      prefetchAhead(g);
+      gradU.noalias() += (u[nb.neighbour[k]] - ui) * g->transpose();
     }
     return Mat<D>::Identity() + gradU;
   }
@@ -290,9 +331,10 @@ class TlsphForces {
       } else {
         const Vec<D> ui = u[i];
         gradU.setZero();
-        for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
-          prefetchAhead(&ref_.correctedGradient[k]);
-          gradU.noalias() += (u[nb.neighbour[k]] - ui) * ref_.correctedGradient[k].transpose();
+        const Vec<D>* g = correctedGradient_.row(i);
+        for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k, ++g) {
+          prefetchAhead(g);
+          gradU.noalias() += (u[nb.neighbour[k]] - ui) * g->transpose();
         }
       }
       const Mat<D> F = Mat<D>::Identity() + gradU;  // (6.69)
@@ -306,7 +348,7 @@ class TlsphForces {
     if (separateHourglassGradient_) {
 #pragma omp parallel for schedule(static)
       for (Index p = 0; p < count; ++p)
-        hourglassF_[group[p]] = deformationGradientOf(group[p], u, ref_.linearGradient);
+        hourglassF_[group[p]] = deformationGradientOf(group[p], u, linearGradient_);
     }
   }
 
@@ -314,7 +356,8 @@ class TlsphForces {
   // the stress uses the quadratic correction.
   void linearReverseGradients(const std::vector<double>& volume) {
     const auto& nb = ref_.neighbours;
-    linearReverse_ = reverseVectors<D>(nb, ref_.linearGradient, volume, ref_.rows());
+    linearReverse_ =
+        SharedRows<Vec<D>>(nb, reverseVectors<D>(nb, ref_.linearGradient, volume, ref_.rows()));
     linearSum_.assign(ref_.particleCount(), Vec<D>::Zero());
     for (Index i = 0; i < ref_.particleCount(); ++i)
       for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k)
@@ -359,15 +402,20 @@ class TlsphForces {
       const Vec<D> ui = u[i];
       if constexpr (SeparateHourglassStress) internal += stress_[i] * linearSum_[i];
       if constexpr (Taylor) internal += q->hyperForceOwn(i);  // through grad grad u
-      for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
+      // particle i's rows of t_IJ (and t^lin_IJ, T_IJ), advanced with k
+      const Vec<D>* t = reverseGradient_.row(i);
+      [[maybe_unused]] const Vec<D>* tLinear =
+          SeparateHourglassStress ? linearReverse_.row(i) : nullptr;
+      [[maybe_unused]] const auto* T = Taylor ? q->reverseRow(i) : nullptr;
+      for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k, ++t) {
         const Index j = nb.neighbour[k];
-        prefetchAhead(&ref_.reverseGradient[k]);
-        internal.noalias() -= S[j] * ref_.reverseGradient[k];
+        prefetchAhead(t);
+        internal.noalias() -= S[j] * *t;
         if constexpr (SeparateHourglassStress) {
-          prefetchAhead(&linearReverse_[k]);
-          internal.noalias() -= stress_[j] * linearReverse_[k];
+          prefetchAhead(tLinear);
+          internal.noalias() -= stress_[j] * *tLinear++;
         }
-        if constexpr (Taylor) internal.noalias() -= q->hyperForcePair(k, j);
+        if constexpr (Taylor) internal.noalias() -= q->hyperForcePair(T++, j);
         if constexpr (Ganzenmueller || Viscous) {
           prefetchAhead(&ref_.separation[k]);
           const Vec<D>& Xij = ref_.separation[k];
@@ -404,9 +452,12 @@ class TlsphForces {
   // Per particle, gathered by the pair loops at the neighbours' indices: huge pages as well.
   LargeArray<Mat<D>> F_;
   LargeArray<Mat<D>> P_;
-  LargeArray<Mat<D>> stress_;        // P + P^hg (energy form only; P^hg alone on the linear F)
-  PairArray<Vec<D>> linearReverse_;  // t^lin_IJ (that case only)
-  std::vector<Vec<D>> linearSum_;    // G^lin_I
+  LargeArray<Mat<D>> stress_;             // P + P^hg (energy form only; P^hg alone on the linear F)
+  SharedRows<Vec<D>> reverseGradient_;    // t_IJ
+  SharedRows<Vec<D>> correctedGradient_;  // g_IJ (nodal quadrature, passive particles)
+  SharedRows<Vec<D>> linearReverse_;      // t^lin_IJ (energy penalty on the linear F only)
+  SharedRows<Vec<D>> linearGradient_;     // g^lin_IJ (the penalty's own F only)
+  std::vector<Vec<D>> linearSum_;         // G^lin_I
   bool separateHourglassGradient_ = false;
   LargeArray<Mat<D>> hourglassF_;
   std::vector<double> hourglassStiffness_;  // K_I
