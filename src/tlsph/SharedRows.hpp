@@ -37,20 +37,20 @@ class SharedRows {
   // must then outlive this (the reference configuration's arrays: a copy would add memory for
   // little less traffic).
   SharedRows(const NeighbourList& nb, const PairArray<T>& full) {
-    const Index stored = plan(nb, full);
-    if (2 * static_cast<std::size_t>(stored) <= full.size())
-      keep(nb, full, stored);
+    const Plan p = plan(nb, full);
+    if (2 * static_cast<std::size_t>(p.stored) <= full.size())
+      keep(nb, full, p);
     else
-      alias(nb, full);
+      alias(nb, full, p);
   }
   // The same for an array handed over: the distinct rows if any row repeats, else full itself.
   SharedRows(const NeighbourList& nb, PairArray<T>&& full) {
-    const Index stored = plan(nb, full);
-    if (static_cast<std::size_t>(stored) < full.size()) {
-      keep(nb, full, stored);
+    const Plan p = plan(nb, full);
+    if (static_cast<std::size_t>(p.stored) < full.size()) {
+      keep(nb, full, p);
     } else {
       values_ = std::move(full);
-      alias(nb, values_);
+      alias(nb, values_, p);
       alias_ = nullptr;
     }
   }
@@ -67,18 +67,21 @@ class SharedRows {
   double storedBytes() const { return double(storedValues()) * sizeof(T); }
   // True when the rows are those of the array given, not a copy.
   bool aliases() const { return alias_ != nullptr; }
-  bool empty() const { return start_.empty(); }
 
  private:
-  // start_ and the first particle of each distinct row (first_); returns the values they hold.
+  struct Plan {
+    Index stored = 0;          // values the distinct rows hold
+    std::vector<Index> first;  // the first particle of each distinct row
+  };
+
+  // Sets start_ (each particle's row in the distinct rows) and returns the plan of those rows.
   // Rows by the hash of their bytes; a hash collision is resolved by comparing the bytes.
-  Index plan(const NeighbourList& nb, const PairArray<T>& full) {
+  Plan plan(const NeighbourList& nb, const PairArray<T>& full) {
     const Index n = nb.particleCount();
     start_.assign(static_cast<std::size_t>(n), 0);
     std::unordered_multimap<std::size_t, Index> firstOf;
     firstOf.reserve(static_cast<std::size_t>(n));
-    first_.clear();
-    Index stored = 0;
+    Plan p;
     for (Index i = 0; i < n; ++i) {
       const std::string_view bytes = rowBytes(nb, full, i);
       const std::size_t hash = std::hash<std::string_view>{}(bytes);
@@ -87,28 +90,26 @@ class SharedRows {
       for (auto it = first; it != last && start < 0; ++it)
         if (rowBytes(nb, full, it->second) == bytes) start = start_[it->second];
       if (start < 0) {
-        start = stored;
-        stored += nb.count(i);
+        start = p.stored;
+        p.stored += nb.count(i);
         firstOf.emplace(hash, i);
-        first_.push_back(i);
+        p.first.push_back(i);
       }
       start_[i] = start;
     }
-    return stored;
+    return p;
   }
-  void keep(const NeighbourList& nb, const PairArray<T>& full, Index stored) {
-    rows_ = first_.size();
-    values_.reserve(static_cast<std::size_t>(stored));
-    for (Index i : first_)
+  void keep(const NeighbourList& nb, const PairArray<T>& full, const Plan& p) {
+    rows_ = p.first.size();
+    values_.reserve(static_cast<std::size_t>(p.stored));
+    for (Index i : p.first)
       values_.insert(values_.end(), full.begin() + nb.offset[i], full.begin() + nb.offset[i + 1]);
-    first_ = {};
   }
-  void alias(const NeighbourList& nb, const PairArray<T>& full) {
-    rows_ = first_.size();
+  void alias(const NeighbourList& nb, const PairArray<T>& full, const Plan& p) {
+    rows_ = p.first.size();
     for (Index i = 0; i < nb.particleCount(); ++i)
       start_[i] = nb.offset[i];
     alias_ = &full;
-    first_ = {};
   }
 
   static std::string_view rowBytes(const NeighbourList& nb, const PairArray<T>& full, Index i) {
@@ -119,7 +120,6 @@ class SharedRows {
   PairArray<T> values_;                  // the distinct rows, back to back (or all, handed over)
   const PairArray<T>* alias_ = nullptr;  // or the rows of this array
   std::vector<Index> start_;             // particle i's row starts at start_[i]
-  std::vector<Index> first_;             // (set-up only)
   std::size_t rows_ = 0;                 // distinct rows
 };
 
