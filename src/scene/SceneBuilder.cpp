@@ -292,6 +292,7 @@ class Builder {
     std::vector<Vec<D>> points;
     try {
       points = fillLattice<D>(shapes, setup_.dx, Vec<D>::Zero(), maxParticles_);
+      lattice_ = latticeAxes<D>(shapes, setup_.dx);  // the ghosts' layers continue it
     } catch (const std::length_error& e) {
       // The geometry's message, in the scene's words.
       std::string what = e.what();
@@ -361,13 +362,14 @@ class Builder {
     const auto box = bounds(shape);
     if (!box) return;
     for (int a = 0; a < D; ++a)
-      if (!geometry_detail::indexSpan(box->min()[a], box->max()[a], 0.0, setup_.dx))
+      if (!withinLatticeReach(std::max(std::abs(box->min()[a]), std::abs(box->max()[a])),
+                              setup_.dx))
         throw r.error("shape",
                       std::string("the body reaches ") + "xyz"[a] + " = " +
                           fmt(std::abs(box->min()[a]) > std::abs(box->max()[a]) ? box->min()[a]
                                                                                 : box->max()[a]) +
                           ", too many lattice spacings (dx = " + fmt(setup_.dx) +
-                          ") from the origin");
+                          ") from the origin (at most 2^20 = 1048576)");
   }
 
   std::uint16_t materialIndex(SectionReader& r) {
@@ -518,8 +520,13 @@ class Builder {
         if (!onBoundingFace(i, face)) continue;
         if (!mirror) clampHeld_.emplace(i, std::pair{name, holds});
         for (long k = 1; k <= layers; ++k) {
+          // Ghost layer k is the lattice's cell k spacings outside X_i, exact on its grid.
+          const LatticeIndex cell = lattice_[axis].index(X[i][axis]) + (sign > 0 ? k : -k);
+          if (!lattice_[axis].holds(cell))
+            throw r.error("layers", std::to_string(layers) +
+                                        " ghost layers reach beyond the lattice's range");
           Vec<D> G = X[i];
-          G[axis] += sign * k * setup_.dx;
+          G[axis] = lattice_[axis].coordinate(cell);
           // Ghost layer k mirrors body layer k across the face (half a spacing outside X_i);
           // the quadratic extrapolation also uses body layer k + 1 (MirrorGhost). Where the
           // body is too thin behind the face (a wedge's tip), the ghost falls back to the
@@ -947,6 +954,7 @@ class Builder {
   double supportRatio_ = 2.0;
   Index bodyCount_ = 0;
   std::map<std::array<long, D>, Index> latticeIndex_;  // lattice point -> body particle
+  std::array<LatticeAxis, D> lattice_{};               // the bodies' lattice
   // Body particles a clamp holds (its face layer, or the layers its ghosts mirror): the clamp's
   // name and what it does, for the error when a [prescribe] region takes one of them too.
   std::map<Index, std::pair<std::string, std::string>> clampHeld_;
