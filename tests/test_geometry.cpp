@@ -451,6 +451,8 @@ TEST(LatticeFill, RejectsBadArguments) {
   EXPECT_THROW(fillLattice<2>(box, 0.0), std::invalid_argument);
   EXPECT_THROW(fillLattice<2>(box, -0.1), std::invalid_argument);
   EXPECT_THROW(fillLattice<2>(box, NAN), std::invalid_argument);
+  EXPECT_THROW(fillLattice<2>(box, 1e-320), std::invalid_argument);  // no grid below it
+  EXPECT_THROW(fillLattice<2>(box, 1e300), std::invalid_argument);
   EXPECT_THROW(fillLattice<2>({}, 0.1), std::invalid_argument);
   try {
     fillLattice<2>({box[0], Box<2>{.lower = v2(0, 0), .upper = v2(1, 0)}}, 0.1);

@@ -131,6 +131,9 @@ std::array<LatticeAxis, D> latticeAxes(const std::vector<Shape<D>>& shapes, doub
   if (!(dx > 0.0) || !std::isfinite(dx))
     throw std::invalid_argument(
         "fillLattice: lattice spacing dx must be positive and finite, got " + numberText(dx));
+  if (!latticeSpacingUsable(dx))
+    throw std::invalid_argument("fillLattice: lattice spacing dx " + numberText(dx) +
+                                " is outside [2^-960, 2^960]");
   if (!origin.allFinite())
     throw std::invalid_argument("fillLattice: lattice origin must be finite, got " +
                                 pointText<D>(origin));

@@ -147,6 +147,9 @@ class Builder {
       throw r.error("name", "must be a file name without '/' (it names the output files), got '" +
                                 setup_.name + "'");
     setup_.dx = r.positive("dx");
+    if (!latticeSpacingUsable(setup_.dx))
+      throw r.error("dx", "must lie between 2^-960 and 2^960 (about 1e-289 and 1e289), got " +
+                              fmt(setup_.dx));
     const long most = r.integer("max_particles", 5'000'000);
     if (most < 1) throw r.error("max_particles", "must be at least 1, got " + fmt(double(most)));
     maxParticles_ = static_cast<std::size_t>(most);

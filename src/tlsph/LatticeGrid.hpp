@@ -33,8 +33,14 @@ inline constexpr double kMaxLatticeSpacings = 0x1p20;
 inline double latticeReach(double largest, double dx) {
   return largest + 2.0 * dx;
 }
+// Whether a lattice of spacing dx (positive, finite, between 2^-960 and 2^960, so that its grid's
+// step and its reach are normal numbers) may reach `largest` from zero.
+inline bool latticeSpacingUsable(double dx) {
+  return dx > 0.0 && std::isfinite(dx) && std::abs(std::ilogb(dx)) <= 960;
+}
 inline bool withinLatticeReach(double largest, double dx) {
-  return latticeReach(largest, dx) <= kMaxLatticeSpacings * dx;
+  return latticeSpacingUsable(dx) && std::isfinite(largest) &&
+         latticeReach(largest, dx) <= kMaxLatticeSpacings * dx;
 }
 
 // One axis of a lattice: cell n sits at (first + n step) quantum.
@@ -60,11 +66,11 @@ struct LatticeAxis {
 };
 
 // The axis with origin `origin` (rounded to the grid) for a lattice of spacing dx reaching
-// `reach` >= |origin| from zero; nullopt if dx is not positive and finite or the reach is more
-// than kMaxLatticeSpacings spacings. Every axis of a lattice (and every body of a scene) must
-// use the same reach, so that they share q and the spacing.
+// `reach` >= |origin| from zero; nullopt if dx is not usable (latticeSpacingUsable) or the
+// reach is more than kMaxLatticeSpacings spacings. Every axis of a lattice (and every body of a
+// scene) must use the same reach, so that they share q and the spacing.
 inline std::optional<LatticeAxis> latticeAxis(double origin, double dx, double reach) {
-  if (!(dx > 0.0) || !std::isfinite(dx) || !std::isfinite(origin) ||
+  if (!latticeSpacingUsable(dx) || !std::isfinite(origin) || !std::isfinite(reach) ||
       !(reach <= kMaxLatticeSpacings * dx) || !(std::abs(origin) <= reach))
     return std::nullopt;
   LatticeAxis axis;
