@@ -59,8 +59,8 @@ void expectSamePoints(const std::vector<Vec<D>>& actual, const std::vector<Vec<D
         << "point " << i << ": " << actual[i].transpose() << " vs " << expected[i].transpose();
 }
 
-// Every lattice point (cell n of latticeAxes, origin + (n + 1/2) dx on its grid) with
-// -m <= n < m that lies in a shape, x fastest.
+// Every lattice point with -m <= n < m that lies in a shape, x fastest: tested at
+// origin + (n + 1/2) dx as evaluated in double, placed at cell n of latticeAxes' grid.
 template <int D>
 std::vector<Vec<D>> bruteForceFill(const std::vector<Shape<D>>& shapes, double dx,
                                    const Vec<D>& origin, int m) {
@@ -69,10 +69,13 @@ std::vector<Vec<D>> bruteForceFill(const std::vector<Shape<D>>& shapes, double d
   std::array<int, D> n;
   n.fill(-m);
   while (n[D - 1] < m) {
-    Vec<D> x;
-    for (int a = 0; a < D; ++a)
+    Vec<D> tested, x;
+    for (int a = 0; a < D; ++a) {
+      tested[a] = origin[a] + (n[a] + 0.5) * dx;
       x[a] = axes[a].coordinate(n[a]);
-    if (std::any_of(shapes.begin(), shapes.end(), [&](const auto& s) { return contains(s, x); }))
+    }
+    if (std::any_of(shapes.begin(), shapes.end(),
+                    [&](const auto& s) { return contains(s, tested); }))
       points.push_back(x);
     for (int a = 0; a < D && ++n[a] == m && a < D - 1; ++a)
       n[a] = -m;
@@ -195,6 +198,24 @@ TEST(LatticeFill, MatchesTestingEveryLatticePoint) {
   const auto points = fillLattice<3>(shapes, dx, origin);
   expectSamePoints<3>(points, bruteForceFill<3>(shapes, dx, origin, 40));
   EXPECT_GT(points.size(), 10000u);
+}
+
+// A face through cell centres: Cook's membrane's top edge y = 0.044 + x/3 holds 8, 16, 32
+// centres at dx = 0.002, 0.001, 0.0005. Whether they are particles is decided where the fill
+// always decided (origin + (n + 1/2) dx in double), not at the exact grid's coordinates, so
+// the exact grid changes no scene's particle set.
+TEST(LatticeFill, PointsOnAFaceKeepTheDecisionOfTheFormula) {
+  const std::vector<Shape<2>> cook = {
+      Polygon<2>{.vertices = {v2(0, 0), v2(0.048, 0.044), v2(0.048, 0.060), v2(0, 0.044)}}};
+  for (const double dx : {0.002, 0.001, 0.0005}) {
+    const auto points = fillLattice<2>(cook, dx);
+    expectSamePoints<2>(points, bruteForceFill<2>(cook, dx, Vec<2>::Zero(), 130));
+    int onEdge = 0;
+    for (int i = 0; (i + 0.5) * dx < 0.048; ++i)
+      for (int j = 0; (j + 0.5) * dx < 0.060; ++j)
+        onEdge += std::abs((j + 0.5) * dx - 0.044 - (i + 0.5) * dx / 3.0) < 1e-12;
+    EXPECT_EQ(onEdge, static_cast<int>(std::lround(0.016 / dx))) << "dx " << dx;
+  }
 }
 
 // 2b. The coordinates are exact on one binary grid (LatticeGrid.hpp): within a hair of

@@ -28,18 +28,24 @@ struct IndexRange {
   std::array<LatticeIndex, D> lo, hi;
 };
 
-// The indices n with lower <= axis.coordinate(n) <= upper, for lower and upper within the
-// lattice's reach.
-inline std::pair<LatticeIndex, LatticeIndex> indexSpan(double lower, double upper,
-                                                       const LatticeAxis& axis) {
-  auto cells = [&](double x) {
-    return (x / axis.quantum - static_cast<double>(axis.first)) / static_cast<double>(axis.step);
-  };
-  auto lo = static_cast<LatticeIndex>(std::ceil(cells(lower)));
-  auto hi = static_cast<LatticeIndex>(std::floor(cells(upper)));
-  // The division rounds; settle the ends on the coordinates actually emitted (monotone in n,
+// Where cell n is tested against the shapes: origin + (n + 1/2) dx evaluated in double, as the
+// fill always did. The point is then placed at cell n of the binary grid (LatticeGrid.hpp), which
+// is within (|n| + 2) q of it, so the exact coordinates change no scene's set of particles: a
+// point that lies on a shape's face up to rounding (Cook's membrane's top edge passes through
+// cell centres) keeps the decision it always had.
+inline double testedCoordinate(double origin, LatticeIndex n, double dx) {
+  return origin + (static_cast<double>(n) + 0.5) * dx;
+}
+
+// The indices n with lower <= testedCoordinate(n) <= upper, for lower and upper within the
+// lattice's reach (|n| well below 2^51, so n + 1/2 is exact).
+inline std::pair<LatticeIndex, LatticeIndex> indexSpan(double lower, double upper, double origin,
+                                                       double dx) {
+  auto lo = static_cast<LatticeIndex>(std::ceil((lower - origin) / dx - 0.5));
+  auto hi = static_cast<LatticeIndex>(std::floor((upper - origin) / dx - 0.5));
+  // The division rounds; settle the ends on the coordinates actually tested (monotone in n,
   // and off by at most one step).
-  auto at = [&](LatticeIndex n) { return axis.coordinate(n); };
+  auto at = [&](LatticeIndex n) { return testedCoordinate(origin, n, dx); };
   for (int k = 0; k < 2 && at(lo - 1) >= lower; ++k)
     --lo;
   for (int k = 0; k < 2 && at(lo) < lower; ++k)
@@ -88,26 +94,32 @@ double unionCount(const std::vector<IndexRange<D>>& ranges, int axis,
 }
 
 // Appends the points of the union inside a shape, walking the slabs from the last axis down so
-// that x varies fastest; a point is tested only against the shapes whose range holds it.
+// that x varies fastest; a point is tested only against the shapes whose range holds it, at its
+// tested coordinates, and placed on the grid of `axes`.
 template <int D>
 void appendUnion(const std::vector<Shape<D>>& shapes, const std::vector<IndexRange<D>>& ranges,
                  int axis, const std::vector<std::size_t>& active,
-                 const std::array<LatticeAxis, D>& axes, std::array<LatticeIndex, D>& n,
-                 std::vector<Vec<D>>& points) {
+                 const std::array<LatticeAxis, D>& axes, const Vec<D>& origin, double dx,
+                 std::array<LatticeIndex, D>& n, std::vector<Vec<D>>& points) {
   forEachSlab<D>(ranges, axis, active,
                  [&](LatticeIndex lo, LatticeIndex hi, const std::vector<std::size_t>& covering) {
                    for (LatticeIndex m = lo; m <= hi; ++m) {
                      n[axis] = m;
                      if (axis > 0) {
-                       appendUnion<D>(shapes, ranges, axis - 1, covering, axes, n, points);
+                       appendUnion<D>(shapes, ranges, axis - 1, covering, axes, origin, dx, n,
+                                      points);
                        continue;
                      }
-                     Vec<D> x;
+                     Vec<D> tested;
                      for (int a = 0; a < D; ++a)
-                       x[a] = axes[a].coordinate(n[a]);
+                       tested[a] = testedCoordinate(origin[a], n[a], dx);
                      if (std::any_of(covering.begin(), covering.end(),
-                                     [&](std::size_t i) { return contains(shapes[i], x); }))
+                                     [&](std::size_t i) { return contains(shapes[i], tested); })) {
+                       Vec<D> x;
+                       for (int a = 0; a < D; ++a)
+                         x[a] = axes[a].coordinate(n[a]);
                        points.push_back(x);
+                     }
                    }
                  });
 }
@@ -169,11 +181,24 @@ std::array<LatticeAxis, D> latticeAxes(const std::vector<Shape<D>>& shapes, doub
   return axes;
 }
 
-// Cell-centred lattice points origin + (n + 1/2) dx (n integer, any sign; exactly, the points
-// of latticeAxes) that lie inside at least one of `shapes` (a union), each point once, ordered
-// x fastest, then y, then z. Throws what latticeAxes throws, and std::length_error if the union
-// of the shapes' bounding boxes holds more than maxPoints lattice points: a memory guard checked
-// before any point is made.
+// The point at which the fill tested the lattice point X that it placed on `axes` (the lattice
+// of spacing dx and origin `origin`): what else decides about a lattice point (holes, the body it
+// belongs to) decides there too, so that the exact grid changes no particle's assignment.
+template <int D>
+Vec<D> testedPoint(const std::array<LatticeAxis, D>& axes, const Vec<D>& X, double dx,
+                   const Vec<D>& origin = Vec<D>::Zero()) {
+  Vec<D> tested;
+  for (int a = 0; a < D; ++a)
+    tested[a] = geometry_detail::testedCoordinate(origin[a], axes[a].index(X[a]), dx);
+  return tested;
+}
+
+// Cell-centred lattice points origin + (n + 1/2) dx (n integer, any sign; placed on the grid of
+// latticeAxes, exactly) that lie inside at least one of `shapes` (a union), each point once,
+// ordered x fastest, then y, then z. Whether a point lies inside is decided at
+// testedCoordinate(): origin + (n + 1/2) dx as evaluated in double. Throws what latticeAxes
+// throws, and std::length_error if the union of the shapes' bounding boxes holds more than
+// maxPoints lattice points: a memory guard checked before any point is made.
 template <int D>
 std::vector<Vec<D>> fillLattice(const std::vector<Shape<D>>& shapes, double dx,
                                 const Vec<D>& origin = Vec<D>::Zero(),
@@ -186,7 +211,7 @@ std::vector<Vec<D>> fillLattice(const std::vector<Shape<D>>& shapes, double dx,
     const auto box = bounds(shapes[i]);
     bool empty = false;
     for (int a = 0; a < D; ++a) {
-      const auto span = indexSpan(box->min()[a], box->max()[a], axes[a]);
+      const auto span = indexSpan(box->min()[a], box->max()[a], origin[a], dx);
       ranges[i].lo[a] = span.first;
       ranges[i].hi[a] = span.second;
       empty = empty || span.first > span.second;
@@ -202,7 +227,7 @@ std::vector<Vec<D>> fillLattice(const std::vector<Shape<D>>& shapes, double dx,
 
   std::vector<Vec<D>> points;
   std::array<LatticeIndex, D> n{};
-  appendUnion<D>(shapes, ranges, D - 1, active, axes, n, points);
+  appendUnion<D>(shapes, ranges, D - 1, active, axes, origin, dx, n, points);
   return points;
 }
 

@@ -314,10 +314,12 @@ class Builder {
                        "the bodies contain no lattice point at dx = " + fmt(setup_.dx) +
                            " (particles sit at cell centres (n + 1/2) dx); make them larger "
                            "than dx");
-    // [hole.NAME]: the lattice points inside a hole belong to no body.
+    // [hole.NAME]: the lattice points inside a hole belong to no body (decided where the fill
+    // decided, testedPoint).
     std::erase_if(points, [&](const Vec<D>& X) {
+      const Vec<D> at = testedPoint<D>(lattice_, X, setup_.dx);
       return std::any_of(holes.begin(), holes.end(),
-                         [&](const Shape<D>& h) { return contains(h, X); });
+                         [&](const Shape<D>& h) { return contains(h, at); });
     });
     if (points.empty()) {
       const std::string hole = "hole." + config_.namesOf("hole").front();
@@ -328,7 +330,8 @@ class Builder {
     auto& p = setup_.scene.particles;
     for (const auto& X : points) {
       std::size_t b = 0;
-      while (b + 1 < shapes.size() && !contains(shapes[b], X))
+      const Vec<D> at = testedPoint<D>(lattice_, X, setup_.dx);
+      while (b + 1 < shapes.size() && !contains(shapes[b], at))
         ++b;
       const std::uint16_t m = materialOfBody[b];
       p.add(X, V, density(setup_.scene.materials[m]) * V, m);
