@@ -118,11 +118,14 @@ int main(int argc, char** argv) {
   const int ny = static_cast<int>(std::lround(0.1 / dx));
   const int ghostLayers = static_cast<int>(std::ceil(supportRatio));
   const double V = dx * dx * dx;
-  for (const auto& X : cellCentredLattice<3>(Vec3(0, -0.05, -0.05), {nx, ny, ny}, dx))
-    scene.particles.add(X, V, 1000.0 * V, 0);
-  for (const auto& X :
-       cellCentredLattice<3>(Vec3(-ghostLayers * dx, -0.05, -0.05), {ghostLayers, ny, ny}, dx))
-    scene.particles.add(X, V, 1000.0 * V, 0, Motion::Prescribed);
+  // One lattice for the beam (x > 0) and its clamped ghost layers (x < 0), so that the offsets
+  // between them are exact too: the body first, then the ghosts.
+  const auto lattice =
+      cellCentredLattice<3>(Vec3(-ghostLayers * dx, -0.05, -0.05), {ghostLayers + nx, ny, ny}, dx);
+  for (const auto& X : lattice)
+    if (X.x() > 0.0) scene.particles.add(X, V, 1000.0 * V, 0);
+  for (const auto& X : lattice)
+    if (X.x() < 0.0) scene.particles.add(X, V, 1000.0 * V, 0, Motion::Prescribed);
 
 #ifdef TLSPH_HAVE_MPI
   Solver<3> solver(scene, {}, comm.get());

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iostream>
 #include <numbers>
 #include <stdexcept>
 #include <string>
@@ -58,18 +59,23 @@ void expectSamePoints(const std::vector<Vec<D>>& actual, const std::vector<Vec<D
         << "point " << i << ": " << actual[i].transpose() << " vs " << expected[i].transpose();
 }
 
-// Every lattice point origin + (n + 1/2) dx with -m <= n < m that lies in a shape, x fastest.
+// Every lattice point with -m <= n < m that lies in a shape, x fastest: tested at
+// origin + (n + 1/2) dx as evaluated in double, placed at cell n of latticeAxes' grid.
 template <int D>
 std::vector<Vec<D>> bruteForceFill(const std::vector<Shape<D>>& shapes, double dx,
                                    const Vec<D>& origin, int m) {
+  const auto axes = latticeAxes<D>(shapes, dx, origin);
   std::vector<Vec<D>> points;
   std::array<int, D> n;
   n.fill(-m);
   while (n[D - 1] < m) {
-    Vec<D> x;
-    for (int a = 0; a < D; ++a)
-      x[a] = origin[a] + (n[a] + 0.5) * dx;
-    if (std::any_of(shapes.begin(), shapes.end(), [&](const auto& s) { return contains(s, x); }))
+    Vec<D> tested, x;
+    for (int a = 0; a < D; ++a) {
+      tested[a] = origin[a] + (n[a] + 0.5) * dx;
+      x[a] = axes[a].coordinate(n[a]);
+    }
+    if (std::any_of(shapes.begin(), shapes.end(),
+                    [&](const auto& s) { return contains(s, tested); }))
       points.push_back(x);
     for (int a = 0; a < D && ++n[a] == m && a < D - 1; ++a)
       n[a] = -m;
@@ -192,6 +198,97 @@ TEST(LatticeFill, MatchesTestingEveryLatticePoint) {
   const auto points = fillLattice<3>(shapes, dx, origin);
   expectSamePoints<3>(points, bruteForceFill<3>(shapes, dx, origin, 40));
   EXPECT_GT(points.size(), 10000u);
+}
+
+// A face through cell centres: Cook's membrane's top edge y = 0.044 + x/3 holds 8, 16, 32
+// centres at dx = 0.002, 0.001, 0.0005. Whether they are particles is decided where the fill
+// always decided (origin + (n + 1/2) dx in double), not at the exact grid's coordinates, so
+// the exact grid changes no scene's particle set.
+TEST(LatticeFill, PointsOnAFaceKeepTheDecisionOfTheFormula) {
+  const std::vector<Shape<2>> cook = {
+      Polygon<2>{.vertices = {v2(0, 0), v2(0.048, 0.044), v2(0.048, 0.060), v2(0, 0.044)}}};
+  for (const double dx : {0.002, 0.001, 0.0005}) {
+    const auto points = fillLattice<2>(cook, dx);
+    expectSamePoints<2>(points, bruteForceFill<2>(cook, dx, Vec<2>::Zero(), 130));
+    int onEdge = 0;
+    for (int i = 0; (i + 0.5) * dx < 0.048; ++i)
+      for (int j = 0; (j + 0.5) * dx < 0.060; ++j)
+        onEdge += std::abs((j + 0.5) * dx - 0.044 - (i + 0.5) * dx / 3.0) < 1e-12;
+    EXPECT_EQ(onEdge, static_cast<int>(std::lround(0.016 / dx))) << "dx " << dx;
+  }
+}
+
+// 2b. The coordinates are exact on one binary grid (LatticeGrid.hpp): within a hair of
+// origin + (n + 1/2) dx, every offset between two points a whole number of one spacing (the
+// same in every body and on every axis), and a lattice about zero mirror-symmetric to the bit.
+
+TEST(LatticeFill, CoordinatesAreCloseToTheFormula) {
+  const double dx = 0.01;
+  const Vec<3> origin = v3(0.0031, -0.0047, 0.0013);
+  const std::vector<Shape<3>> shapes = {
+      Box<3>{.lower = v3(-0.3, -0.05, -0.05), .upper = v3(0.7, 0.05, 0.05)}};
+  const auto points = fillLattice<3>(shapes, dx, origin);
+  ASSERT_EQ(points.size(), 100u * 10u * 10u);
+  // The grid's step q = 2^(ilogb(reach) - 50) = 2^-51 here: the spacing is within q of dx and
+  // the origin within q/2, so cell n moves by at most (|n| + 1) q from the formula.
+  const double q = 0x1p-51;
+  double worst = 0.0;
+  for (const auto& x : points)
+    for (int a = 0; a < 3; ++a) {
+      const double n = std::round((x[a] - origin[a]) / dx - 0.5);
+      const double moved = std::abs(x[a] - (origin[a] + (n + 0.5) * dx));
+      EXPECT_LE(moved, (std::abs(n) + 2.0) * q) << x.transpose();
+      worst = std::max(worst, moved);
+    }
+  std::cout << "largest move from the formula: " << worst << " (" << worst / dx << " dx)\n";
+}
+
+TEST(LatticeFill, OffsetsAreWholeSpacingsInEveryBodyAndAxis) {
+  const double dx = 0.01;
+  const std::vector<Shape<3>> shapes = {
+      Box<3>{.lower = v3(0.1, 0.0, 0.0), .upper = v3(0.35, 0.05, 0.03)},
+      Ball<3>{.centre = v3(-0.4, 0.2, 0.1), .radius = 0.06}};
+  const auto axes = latticeAxes<3>(shapes, dx);
+  const double spacing = axes[0].spacing();
+  EXPECT_EQ(axes[1].spacing(), spacing);
+  EXPECT_EQ(axes[2].spacing(), spacing);
+  EXPECT_LE(std::abs(spacing - dx), axes[0].quantum);
+  const auto points = fillLattice<3>(shapes, dx);
+  ASSERT_GT(points.size(), 1000u);
+  // Against a point of the box, every point's offset is exact: m spacings, m an integer.
+  const Vec<3> anchor = points.front();
+  for (const auto& x : points)
+    for (int a = 0; a < 3; ++a) {
+      const double offset = x[a] - anchor[a];
+      const double m = std::round(offset / spacing);
+      ASSERT_EQ(offset, m * spacing) << x.transpose() << " axis " << a;
+    }
+}
+
+TEST(LatticeFill, LatticeAboutZeroIsMirrorSymmetric) {
+  const double dx = 0.0125;
+  const auto points = fillLattice<2>({Box<2>{.lower = v2(-0.3, -0.1), .upper = v2(0.3, 0.1)}}, dx);
+  ASSERT_EQ(points.size(), 48u * 16u);
+  std::vector<Vec<2>> mirrored;
+  for (const auto& x : points)
+    mirrored.push_back(-x);
+  std::sort(mirrored.begin(), mirrored.end(), latticeLess<2>);
+  expectSamePoints<2>(points, mirrored);
+}
+
+TEST(LatticeFill, RejectsALatticeReachingTooFarFromZero) {
+  const std::vector<Shape<2>> far = {Box<2>{.lower = v2(3e4, 0), .upper = v2(3e4 + 1, 1)}};
+  try {
+    fillLattice<2>(far, 0.01);
+    ADD_FAILURE() << "a box 3e6 spacings from zero was filled";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("shape 0 reaches more than 2^20 lattice spacings (dx "
+                                         "0.01) from zero along x"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(fillLattice<2>(far, 0.05).size(), 20u * 20u);  // 6e5 spacings: within reach
+  EXPECT_THROW(cellCentredLattice<2>(v2(3e4, 0), {2, 2}, 0.01), std::invalid_argument);
 }
 
 // 3. Polygons: non-convex, either orientation, extruded along any axis.
@@ -375,6 +472,8 @@ TEST(LatticeFill, RejectsBadArguments) {
   EXPECT_THROW(fillLattice<2>(box, 0.0), std::invalid_argument);
   EXPECT_THROW(fillLattice<2>(box, -0.1), std::invalid_argument);
   EXPECT_THROW(fillLattice<2>(box, NAN), std::invalid_argument);
+  EXPECT_THROW(fillLattice<2>(box, 1e-320), std::invalid_argument);  // no grid below it
+  EXPECT_THROW(fillLattice<2>(box, 1e300), std::invalid_argument);
   EXPECT_THROW(fillLattice<2>({}, 0.1), std::invalid_argument);
   try {
     fillLattice<2>({box[0], Box<2>{.lower = v2(0, 0), .upper = v2(1, 0)}}, 0.1);
@@ -416,7 +515,7 @@ TEST(LatticeFill, MaxPointsGuard) {
 
   // A mistyped dx fails at once instead of exhausting memory.
   const std::string huge =
-      lengthErrorOf([] { fillLattice<3>({Ball<3>{.centre = v3(0, 0, 0), .radius = 1.0}}, 1e-9); });
+      lengthErrorOf([] { fillLattice<3>({Ball<3>{.centre = v3(0, 0, 0), .radius = 1.0}}, 1e-5); });
   EXPECT_NE(huge.find("limit 50000000"), std::string::npos) << huge;
 }
 

@@ -2,6 +2,7 @@
 // expected; good input builds the scene it describes.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <string>
 
 #include "scene/Config.hpp"
@@ -223,6 +224,21 @@ TEST(SceneInput, MovingClampIsAPrescriptionFollowedByItsGhosts) {
   EXPECT_EQ(setup.scene.mirrorGhosts.size(), 3u * 4u);
   for (const auto& m : setup.scene.mirrorGhosts)
     EXPECT_EQ(m.motion, 0);
+}
+
+// The clamp's ghost layers continue the bodies' lattice exactly: along each axis, all the
+// scene's coordinates are whole spacings apart, the same spacing on every axis.
+TEST(SceneInput, GhostsContinueTheExactLattice) {
+  const auto setup = buildScene<2>(Config::parse(kGood, "scene.ini"));
+  const auto& X = setup.scene.particles.referencePosition;
+  ASSERT_GT(setup.scene.mirrorGhosts.size(), 0u);
+  const double spacing = X[1][0] - X[0][0];  // two neighbours along x in the body
+  EXPECT_NEAR(spacing, 0.01, 1e-15);
+  for (const auto& x : X)
+    for (int a = 0; a < 2; ++a) {
+      const double offset = x[a] - X[0][a];
+      ASSERT_EQ(offset, std::round(offset / spacing) * spacing) << x.transpose();
+    }
 }
 
 TEST(SceneInput, LoadOnAFaceTakesTheSurfaceLayerOnly) {

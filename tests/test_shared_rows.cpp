@@ -103,13 +103,12 @@ TEST(SharedRows, CopiesOnlyWhenItPays) {
   expectRowsReadBack(nb, distinct, whole);
 }
 
-// On a lattice whose coordinates are exact (a power-of-two spacing) every particle with the same
-// neighbourhood has the same rows to the last bit: they are stored once, and every particle still
-// reads its own. (With dx = 0.01 the coordinates round differently from cell to cell and no two
-// rows agree: then the loops read the reference's arrays in place.)
+// On a lattice, whose coordinates are exact on one binary grid (LatticeGrid.hpp) whatever dx and
+// the origin, every particle with the same neighbourhood has the same rows to the last bit: they
+// are stored once, and every particle still reads its own.
 TEST(SharedRows, LatticeRowsAreSharedAndReadBack) {
-  const double dx = 1.0 / 64.0;
-  const auto X = cellCentredLattice<3>(Vec3::Zero(), {20, 8, 8}, dx);
+  const double dx = 0.01;
+  const auto X = cellCentredLattice<3>(Vec3(0.0031, -0.05, -0.0047), {20, 8, 8}, dx);
   const std::vector<double> volume(X.size(), dx * dx * dx);
   const auto ref = buildReferenceConfiguration<3>(
       X, volume, Kernel<3>(KernelType::WendlandC2, 2.1 * dx), {}, GradientCorrection::Quadratic);

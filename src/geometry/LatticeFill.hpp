@@ -15,13 +15,12 @@
 #include "geometry/MessageText.hpp"
 #include "geometry/PointSets.hpp"  // select() and boundingBox() go with filling
 #include "geometry/Shape.hpp"
+#include "tlsph/LatticeGrid.hpp"
 #include "tlsph/Types.hpp"
 
 namespace tlsph {
 
 namespace geometry_detail {
-
-using LatticeIndex = std::int64_t;
 
 // Inclusive lattice index ranges per axis; empty when lo > hi on some axis.
 template <int D>
@@ -29,24 +28,24 @@ struct IndexRange {
   std::array<LatticeIndex, D> lo, hi;
 };
 
-// The one expression for a lattice coordinate, shared by the range search and the emitted points
-// so that both agree to the last bit (and with cellCentredLattice for a zero origin).
-inline double latticeCoordinate(double origin, LatticeIndex n, double dx) {
+// Where cell n is tested against the shapes: origin + (n + 1/2) dx evaluated in double, as the
+// fill always did. The point is then placed at cell n of the binary grid (LatticeGrid.hpp), which
+// is within (|n| + 2) q of it, so the exact coordinates change no scene's set of particles: a
+// point that lies on a shape's face up to rounding (Cook's membrane's top edge passes through
+// cell centres) keeps the decision it always had.
+inline double testedCoordinate(double origin, LatticeIndex n, double dx) {
   return origin + (static_cast<double>(n) + 0.5) * dx;
 }
 
-// The indices n with lower <= latticeCoordinate(n) <= upper, or nullopt if they are too large
-// for (n + 1/2) to be exact in a double.
-inline std::optional<std::pair<LatticeIndex, LatticeIndex>> indexSpan(double lower, double upper,
-                                                                      double origin, double dx) {
-  const double first = std::ceil((lower - origin) / dx - 0.5);
-  const double last = std::floor((upper - origin) / dx - 0.5);
-  constexpr double limit = 0x1p51;
-  if (!(std::abs(first) < limit && std::abs(last) < limit)) return std::nullopt;
-  auto lo = static_cast<LatticeIndex>(first), hi = static_cast<LatticeIndex>(last);
-  // The division rounds; settle the ends on the coordinates actually emitted (monotone in n,
+// The indices n with lower <= testedCoordinate(n) <= upper, for lower and upper within the
+// lattice's reach (|n| well below 2^51, so n + 1/2 is exact).
+inline std::pair<LatticeIndex, LatticeIndex> indexSpan(double lower, double upper, double origin,
+                                                       double dx) {
+  auto lo = static_cast<LatticeIndex>(std::ceil((lower - origin) / dx - 0.5));
+  auto hi = static_cast<LatticeIndex>(std::floor((upper - origin) / dx - 0.5));
+  // The division rounds; settle the ends on the coordinates actually tested (monotone in n,
   // and off by at most one step).
-  auto at = [&](LatticeIndex n) { return latticeCoordinate(origin, n, dx); };
+  auto at = [&](LatticeIndex n) { return testedCoordinate(origin, n, dx); };
   for (int k = 0; k < 2 && at(lo - 1) >= lower; ++k)
     --lo;
   for (int k = 0; k < 2 && at(lo) < lower; ++k)
@@ -95,25 +94,32 @@ double unionCount(const std::vector<IndexRange<D>>& ranges, int axis,
 }
 
 // Appends the points of the union inside a shape, walking the slabs from the last axis down so
-// that x varies fastest; a point is tested only against the shapes whose range holds it.
+// that x varies fastest; a point is tested only against the shapes whose range holds it, at its
+// tested coordinates, and placed on the grid of `axes`.
 template <int D>
 void appendUnion(const std::vector<Shape<D>>& shapes, const std::vector<IndexRange<D>>& ranges,
-                 int axis, const std::vector<std::size_t>& active, const Vec<D>& origin, double dx,
+                 int axis, const std::vector<std::size_t>& active,
+                 const std::array<LatticeAxis, D>& axes, const Vec<D>& origin, double dx,
                  std::array<LatticeIndex, D>& n, std::vector<Vec<D>>& points) {
   forEachSlab<D>(ranges, axis, active,
                  [&](LatticeIndex lo, LatticeIndex hi, const std::vector<std::size_t>& covering) {
                    for (LatticeIndex m = lo; m <= hi; ++m) {
                      n[axis] = m;
                      if (axis > 0) {
-                       appendUnion<D>(shapes, ranges, axis - 1, covering, origin, dx, n, points);
+                       appendUnion<D>(shapes, ranges, axis - 1, covering, axes, origin, dx, n,
+                                      points);
                        continue;
                      }
-                     Vec<D> x;
+                     Vec<D> tested;
                      for (int a = 0; a < D; ++a)
-                       x[a] = latticeCoordinate(origin[a], n[a], dx);
+                       tested[a] = testedCoordinate(origin[a], n[a], dx);
                      if (std::any_of(covering.begin(), covering.end(),
-                                     [&](std::size_t i) { return contains(shapes[i], x); }))
+                                     [&](std::size_t i) { return contains(shapes[i], tested); })) {
+                       Vec<D> x;
+                       for (int a = 0; a < D; ++a)
+                         x[a] = axes[a].coordinate(n[a]);
                        points.push_back(x);
+                     }
                    }
                  });
 }
@@ -124,26 +130,33 @@ inline std::string countText(double count) {
 
 }  // namespace geometry_detail
 
-// Cell-centred lattice points origin + (n + 1/2) dx (n integer, any sign) that lie inside at
-// least one of `shapes` (a union), each point once, ordered x fastest, then y, then z. Throws
-// std::invalid_argument if dx <= 0, if shapes is empty or one is invalid or unbounded
-// (half-space), and std::length_error if the union of the shapes' bounding boxes holds more than
-// maxPoints lattice points: a memory guard checked before any point is made.
+// The axes of the lattice of spacing dx and origin `origin` on which fillLattice places the
+// points of `shapes` (LatticeGrid.hpp: coordinates exact on one binary grid, its reach that of
+// all the shapes' bounding boxes and the origin, so that every body of a scene shares it).
+// Throws std::invalid_argument if dx <= 0, if shapes is empty or one is invalid or unbounded
+// (half-space), or if a shape or the origin lies more than kMaxLatticeSpacings spacings from
+// zero.
 template <int D>
-std::vector<Vec<D>> fillLattice(const std::vector<Shape<D>>& shapes, double dx,
-                                const Vec<D>& origin = Vec<D>::Zero(),
-                                std::size_t maxPoints = 50'000'000) {
+std::array<LatticeAxis, D> latticeAxes(const std::vector<Shape<D>>& shapes, double dx,
+                                       const Vec<D>& origin = Vec<D>::Zero()) {
   using namespace geometry_detail;
   if (!(dx > 0.0) || !std::isfinite(dx))
     throw std::invalid_argument(
         "fillLattice: lattice spacing dx must be positive and finite, got " + numberText(dx));
+  if (!latticeSpacingUsable(dx))
+    throw std::invalid_argument("fillLattice: lattice spacing dx " + numberText(dx) +
+                                " is outside [2^-960, 2^960]");
   if (!origin.allFinite())
     throw std::invalid_argument("fillLattice: lattice origin must be finite, got " +
                                 pointText<D>(origin));
   if (shapes.empty()) throw std::invalid_argument("fillLattice: no shapes to fill");
-
-  std::vector<IndexRange<D>> ranges(shapes.size());
-  std::vector<std::size_t> active;  // shapes whose bounds hold at least one lattice point
+  auto tooFar = [&](const std::string& what, int a) {
+    return std::invalid_argument(what + " reaches more than 2^20 lattice spacings (dx " +
+                                 numberText(dx) + ") from zero along " + std::string(axisName(a)));
+  };
+  double largest = origin.cwiseAbs().maxCoeff();
+  for (int a = 0; a < D; ++a)
+    if (!withinLatticeReach(std::abs(origin[a]), dx)) throw tooFar("fillLattice: the origin", a);
   for (std::size_t i = 0; i < shapes.size(); ++i) {
     const std::string which = "fillLattice: shape " + std::to_string(i);
     try {
@@ -156,16 +169,52 @@ std::vector<Vec<D>> fillLattice(const std::vector<Shape<D>>& shapes, double dx,
       throw std::invalid_argument(which + " (" + std::string(shapeName(shapes[i])) +
                                   ") is unbounded and cannot be filled with particles; it can "
                                   "only select particles of a region");
+    for (int a = 0; a < D; ++a) {
+      const double far = std::max(std::abs(box->min()[a]), std::abs(box->max()[a]));
+      if (!withinLatticeReach(far, dx)) throw tooFar(which, a);
+      largest = std::max(largest, far);
+    }
+  }
+  std::array<LatticeAxis, D> axes;
+  for (int a = 0; a < D; ++a)
+    axes[a] = *latticeAxis(origin[a], dx, latticeReach(largest, dx));
+  return axes;
+}
+
+// The point at which the fill tested the lattice point X that it placed on `axes` (the lattice
+// of spacing dx and origin `origin`): what else decides about a lattice point (holes, the body it
+// belongs to) decides there too, so that the exact grid changes no particle's assignment.
+template <int D>
+Vec<D> testedPoint(const std::array<LatticeAxis, D>& axes, const Vec<D>& X, double dx,
+                   const Vec<D>& origin = Vec<D>::Zero()) {
+  Vec<D> tested;
+  for (int a = 0; a < D; ++a)
+    tested[a] = geometry_detail::testedCoordinate(origin[a], axes[a].index(X[a]), dx);
+  return tested;
+}
+
+// Cell-centred lattice points origin + (n + 1/2) dx (n integer, any sign; placed on the grid of
+// latticeAxes, exactly) that lie inside at least one of `shapes` (a union), each point once,
+// ordered x fastest, then y, then z. Whether a point lies inside is decided at
+// testedCoordinate(): origin + (n + 1/2) dx as evaluated in double. Throws what latticeAxes
+// throws, and std::length_error if the union of the shapes' bounding boxes holds more than
+// maxPoints lattice points: a memory guard checked before any point is made.
+template <int D>
+std::vector<Vec<D>> fillLattice(const std::vector<Shape<D>>& shapes, double dx,
+                                const Vec<D>& origin = Vec<D>::Zero(),
+                                std::size_t maxPoints = 50'000'000) {
+  using namespace geometry_detail;
+  const std::array<LatticeAxis, D> axes = latticeAxes<D>(shapes, dx, origin);
+  std::vector<IndexRange<D>> ranges(shapes.size());
+  std::vector<std::size_t> active;  // shapes whose bounds hold at least one lattice point
+  for (std::size_t i = 0; i < shapes.size(); ++i) {
+    const auto box = bounds(shapes[i]);
     bool empty = false;
     for (int a = 0; a < D; ++a) {
       const auto span = indexSpan(box->min()[a], box->max()[a], origin[a], dx);
-      if (!span)
-        throw std::invalid_argument(which + " lies too many lattice spacings (dx " +
-                                    numberText(dx) + ") from the origin along " +
-                                    std::string(axisName(a)));
-      ranges[i].lo[a] = span->first;
-      ranges[i].hi[a] = span->second;
-      empty = empty || span->first > span->second;
+      ranges[i].lo[a] = span.first;
+      ranges[i].hi[a] = span.second;
+      empty = empty || span.first > span.second;
     }
     if (!empty) active.push_back(i);
   }
@@ -178,7 +227,7 @@ std::vector<Vec<D>> fillLattice(const std::vector<Shape<D>>& shapes, double dx,
 
   std::vector<Vec<D>> points;
   std::array<LatticeIndex, D> n{};
-  appendUnion<D>(shapes, ranges, D - 1, active, origin, dx, n, points);
+  appendUnion<D>(shapes, ranges, D - 1, active, axes, origin, dx, n, points);
   return points;
 }
 

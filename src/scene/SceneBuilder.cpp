@@ -147,6 +147,9 @@ class Builder {
       throw r.error("name", "must be a file name without '/' (it names the output files), got '" +
                                 setup_.name + "'");
     setup_.dx = r.positive("dx");
+    if (!latticeSpacingUsable(setup_.dx))
+      throw r.error("dx", "must lie between 2^-960 and 2^960 (about 1e-289 and 1e289), got " +
+                              fmt(setup_.dx));
     const long most = r.integer("max_particles", 5'000'000);
     if (most < 1) throw r.error("max_particles", "must be at least 1, got " + fmt(double(most)));
     maxParticles_ = static_cast<std::size_t>(most);
@@ -292,6 +295,7 @@ class Builder {
     std::vector<Vec<D>> points;
     try {
       points = fillLattice<D>(shapes, setup_.dx, Vec<D>::Zero(), maxParticles_);
+      lattice_ = latticeAxes<D>(shapes, setup_.dx);  // the ghosts' layers continue it
     } catch (const std::length_error& e) {
       // The geometry's message, in the scene's words.
       std::string what = e.what();
@@ -310,10 +314,12 @@ class Builder {
                        "the bodies contain no lattice point at dx = " + fmt(setup_.dx) +
                            " (particles sit at cell centres (n + 1/2) dx); make them larger "
                            "than dx");
-    // [hole.NAME]: the lattice points inside a hole belong to no body.
+    // [hole.NAME]: the lattice points inside a hole belong to no body (decided where the fill
+    // decided, testedPoint).
     std::erase_if(points, [&](const Vec<D>& X) {
+      const Vec<D> at = testedPoint<D>(lattice_, X, setup_.dx);
       return std::any_of(holes.begin(), holes.end(),
-                         [&](const Shape<D>& h) { return contains(h, X); });
+                         [&](const Shape<D>& h) { return contains(h, at); });
     });
     if (points.empty()) {
       const std::string hole = "hole." + config_.namesOf("hole").front();
@@ -324,7 +330,8 @@ class Builder {
     auto& p = setup_.scene.particles;
     for (const auto& X : points) {
       std::size_t b = 0;
-      while (b + 1 < shapes.size() && !contains(shapes[b], X))
+      const Vec<D> at = testedPoint<D>(lattice_, X, setup_.dx);
+      while (b + 1 < shapes.size() && !contains(shapes[b], at))
         ++b;
       const std::uint16_t m = materialOfBody[b];
       p.add(X, V, density(setup_.scene.materials[m]) * V, m);
@@ -361,13 +368,14 @@ class Builder {
     const auto box = bounds(shape);
     if (!box) return;
     for (int a = 0; a < D; ++a)
-      if (!geometry_detail::indexSpan(box->min()[a], box->max()[a], 0.0, setup_.dx))
+      if (!withinLatticeReach(std::max(std::abs(box->min()[a]), std::abs(box->max()[a])),
+                              setup_.dx))
         throw r.error("shape",
                       std::string("the body reaches ") + "xyz"[a] + " = " +
                           fmt(std::abs(box->min()[a]) > std::abs(box->max()[a]) ? box->min()[a]
                                                                                 : box->max()[a]) +
                           ", too many lattice spacings (dx = " + fmt(setup_.dx) +
-                          ") from the origin");
+                          ") from the origin (at most 2^20 = 1048576)");
   }
 
   std::uint16_t materialIndex(SectionReader& r) {
@@ -518,8 +526,13 @@ class Builder {
         if (!onBoundingFace(i, face)) continue;
         if (!mirror) clampHeld_.emplace(i, std::pair{name, holds});
         for (long k = 1; k <= layers; ++k) {
+          // Ghost layer k is the lattice's cell k spacings outside X_i, exact on its grid.
+          const LatticeIndex cell = lattice_[axis].index(X[i][axis]) + (sign > 0 ? k : -k);
+          if (!lattice_[axis].holds(cell))
+            throw r.error("layers", std::to_string(layers) +
+                                        " ghost layers reach beyond the lattice's range");
           Vec<D> G = X[i];
-          G[axis] += sign * k * setup_.dx;
+          G[axis] = lattice_[axis].coordinate(cell);
           // Ghost layer k mirrors body layer k across the face (half a spacing outside X_i);
           // the quadratic extrapolation also uses body layer k + 1 (MirrorGhost). Where the
           // body is too thin behind the face (a wedge's tip), the ghost falls back to the
@@ -947,6 +960,7 @@ class Builder {
   double supportRatio_ = 2.0;
   Index bodyCount_ = 0;
   std::map<std::array<long, D>, Index> latticeIndex_;  // lattice point -> body particle
+  std::array<LatticeAxis, D> lattice_{};               // the bodies' lattice
   // Body particles a clamp holds (its face layer, or the layers its ghosts mirror): the clamp's
   // name and what it does, for the error when a [prescribe] region takes one of them too.
   std::map<Index, std::pair<std::string, std::string>> clampHeld_;
