@@ -13,7 +13,6 @@
 
 #include <cassert>
 #include <cstddef>
-#include <cstring>
 #include <functional>
 #include <string_view>
 #include <unordered_map>
