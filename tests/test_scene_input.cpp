@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <iomanip>
+#include <sstream>
 #include <string>
 
 #include "scene/Config.hpp"
@@ -239,6 +241,31 @@ TEST(SceneInput, GhostsContinueTheExactLattice) {
       const double offset = x[a] - X[0][a];
       ASSERT_EQ(offset, std::round(offset / spacing) * spacing) << x.transpose();
     }
+}
+
+// Region faces through cell centres: which particles a region selects is decided at
+// (n + 1/2) dx as evaluated in double, where the fill decides which cells are particles, not at
+// the particles' positions on the exact grid (which differ from it in the last bits).
+TEST(SceneInput, RegionFacesThroughCellCentresDecideAsTheFill) {
+  const double dx = 0.01;
+  const std::string body = replaced(kGood, "upper = 0.2 0.04\n[clamp", "upper = 1 0.04\n[clamp");
+  auto centre = [&](int n) { return (n + 0.5) * dx; };  // the formula's centre of column n
+  int differ = 0;
+  for (int n = 0; n + 10 < 100; n += 3) {
+    std::ostringstream box;
+    box << std::setprecision(17) << "lower = " << centre(n) << " 0\nupper = " << centre(n + 10)
+        << " 0.04";
+    const std::string text = replaced(body, "lower = 0.19 0\nupper = 0.2 0.04", box.str());
+    const auto setup = buildScene<2>(Config::parse(text, "scene.ini"));
+    const auto& X = setup.scene.particles.referencePosition;
+    const auto& tip = setup.regions.at("tip");
+    EXPECT_EQ(tip.size(), 4u * 11u) << box.str();  // columns n to n + 10, both faces' included
+    for (Index i : tip)
+      for (int m : {n, n + 10})
+        differ += X[i][0] != centre(m) && std::abs(X[i][0] - centre(m)) < 1e-12;
+  }
+  // The test means something only where the grid's coordinate is not the formula's.
+  EXPECT_GT(differ, 0);
 }
 
 TEST(SceneInput, LoadOnAFaceTakesTheSurfaceLayerOnly) {

@@ -389,8 +389,13 @@ class Builder {
   }
 
   void readRegions() {
+    // A region selects the body particles whose cells it holds, decided where the fill decided
+    // which cells are particles (testedPoint: (n + 1/2) dx as evaluated in double), so that a
+    // region face through cell centres selects what it selected before the exact grid.
     const auto& X = setup_.scene.particles.referencePosition;
-    const std::vector<Vec<D>> bodyX(X.begin(), X.begin() + bodyCount_);
+    std::vector<Vec<D>> bodyX(static_cast<std::size_t>(bodyCount_));
+    for (Index i = 0; i < bodyCount_; ++i)
+      bodyX[i] = testedPoint<D>(lattice_, X[i], setup_.dx);
     for (const auto& name : config_.namesOf("region")) {
       SectionReader r(config_, "region." + name);
       if (name == "all") throw r.error("", "'all' is a built-in region (every body particle)");
