@@ -72,18 +72,36 @@ TEST(Probes, KernelProbeIsExactForAffineFieldsAtSurfacePoints) {
   const Vec<2> a = c + G * Vec<2>(0.195, 0.015), b = c + G * Vec<2>(0.195, 0.025);
   EXPECT_TRUE(std::abs(nearX - a.x()) < 1e-14 || std::abs(nearX - b.x()) < 1e-14) << nearX;
 
-  // A homogeneous deformation: every particle has the same F, so the stress probe is the
-  // material's Cauchy stress for that F (plane strain: sigma_zz included, no xz, yz).
-  const Mat3 F3 = embedDeformationGradient<2>(Mat<2>::Identity() + G);
+  // A homogeneous deformation: every particle has the same F up to the rounding of its
+  // gradient vectors (the corrected fit reproduces an affine field to about 1e-13 here), so the
+  // stress probe, a weighted mean of the particles' stresses (Shepard: positive weights summing
+  // to one), is the material's Cauchy stress for that F within the largest particle's deviation
+  // from it (plane strain: sigma_zz included, no xz, yz).
+  const Mat<2> Fexact = Mat<2>::Identity() + G;
+  const Mat3 F3 = embedDeformationGradient<2>(Fexact);
   const Mat3 P = std::visit([&](const auto& m) { return m.firstPiolaKirchhoff(F3); },
                             setup.scene.materials[0]);
   const Mat3 sigma = P * F3.transpose() / F3.determinant();
   const double scale = sigma.norm();
-  EXPECT_NEAR(value("tip_sxx"), sigma(0, 0), 1e-12 * scale);
-  EXPECT_NEAR(value("tip_syy"), sigma(1, 1), 1e-12 * scale);
-  EXPECT_NEAR(value("tip_szz"), sigma(2, 2), 1e-12 * scale);
-  EXPECT_NEAR(value("tip_sxy"), sigma(0, 1), 1e-12 * scale);
-  EXPECT_NEAR(value("tip_syz"), 0.0, 1e-12 * scale);
-  EXPECT_NEAR(value("tip_sxz"), 0.0, 1e-12 * scale);
+  const auto& tipProbe = setup.probes.front();
+  ASSERT_EQ(tipProbe.name, "tip");
+  double weightSum = 0.0, deviation = 0.0;
+  for (std::size_t k = 0; k < tipProbe.particles.size(); ++k) {
+    const Index j = tipProbe.particles[k];
+    EXPECT_GT(tipProbe.weights[k], 0.0);
+    weightSum += tipProbe.weights[k];
+    const Mat<2>& Fj = solver.forces().deformationGradient()[j];
+    EXPECT_LT((Fj - Fexact).cwiseAbs().maxCoeff(), 1e-12) << j;  // the patch test's F
+    deviation = std::max(deviation, (cauchyStressOf(setup, Fj, j) - sigma).cwiseAbs().maxCoeff());
+  }
+  EXPECT_NEAR(weightSum, 1.0, 1e-14);
+  EXPECT_LT(deviation, 1e-10 * scale);  // what F's rounding can make of the stress
+  const double bound = deviation + 1e-14 * scale;
+  EXPECT_NEAR(value("tip_sxx"), sigma(0, 0), bound);
+  EXPECT_NEAR(value("tip_syy"), sigma(1, 1), bound);
+  EXPECT_NEAR(value("tip_szz"), sigma(2, 2), bound);
+  EXPECT_NEAR(value("tip_sxy"), sigma(0, 1), bound);
+  EXPECT_NEAR(value("tip_syz"), 0.0, bound);
+  EXPECT_NEAR(value("tip_sxz"), 0.0, bound);
   EXPECT_GT(std::abs(sigma(2, 2)), 1e-3 * scale);
 }
