@@ -10,7 +10,7 @@
 #   defaults: dx 0.0125 (5,312 particles), steps 200, procs "1 2" (MACHDYN: MPI ranks, one
 #   OpenMP thread each; tlsph: OpenMP threads, one process). Issue 12's sizes: 0.0125 2000 and
 #   0.00625 200. Environment: MPIRUN (default mpirun), HG (both codes' hourglass coefficient,
-#   default 10), CFL (default 0.3).
+#   default 10), CFL (default 0.3), PAIRED=1 (one core each, both codes at once; below).
 #
 # Equal in both codes: the particles (cell-centred cubic lattice of spacing dx: an 80 x 8 x 8 body
 # at dx 0.0125 plus ceil(2.1) = 3 clamp layers at x < 0 that never move), volume dx^3, density
@@ -107,6 +107,39 @@ EOF
 
 echo "# dx $dx: ${nx}x${ny}x${ny} body + $layers clamp layers, $steps steps, hg = alpha = $HG;" \
   "MACHDYN logs in $work"
+# PAIRED=1: one core each, both codes at the same time (each pinned with taskset to its own
+# core), then again with the cores swapped: on a shared host whose speed drifts by tens of
+# percent over minutes (seen on the Zen 4 development machine), the two codes then see the same
+# host, and the ratio is measured within each run (tlsph, the faster, runs wholly inside
+# MACHDYN's run). Needs 2 cores; the procs are ignored.
+if [ "${PAIRED:-0}" = 1 ]; then
+  command -v taskset >/dev/null || { echo "PAIRED=1 needs taskset (util-linux)" >&2; exit 2; }
+  [ -x build/tlsph_bench ] || { echo "(no build/tlsph_bench: build tlsph to compare)"; exit 0; }
+  [ "$(nproc)" -ge 2 ] || { echo "PAIRED=1 needs 2 cores, this machine has $(nproc)" >&2; exit 2; }
+  extra=$(build/tlsph_bench --help | grep -q -- --no-stream && echo --no-stream)
+  printf "%-18s %-9s %12s %-9s %12s %9s\n" config MACHDYN p-steps/s tlsph p-steps/s tlsph/MD
+  for config in "bench-default" "quadratic-taylor"; do
+    args="--dx $dx --steps $steps --alpha $HG $extra"
+    [ "$config" = quadratic-taylor ] && args="$args --correction quadratic --quadrature taylor"
+    for swap in 0 1; do
+      cm=$swap; ct=$((1 - swap)); log=$work/log.paired.$config.$swap
+      # one rank without mpirun (MPI's singleton start), pinned like the tlsph process
+      OMP_NUM_THREADS=1 taskset -c "$cm" "$LMP" -in "$work/in.cantilever" -log "$log" \
+        -screen none -var dx "$dx" -var nx "$nx" -var ny "$ny" -var layers "$layers" \
+        -var support "$support" -var hg "$HG" -var dt "$dt" -var steps "$steps" \
+        >"$work/out.paired" 2>&1 &
+      out=$(OMP_NUM_THREADS=1 taskset -c "$ct" build/tlsph_bench $args 2>&1)
+      wait
+      md=$(grep -s "^Loop time of" "$log" | tail -1 | awk '{print $12 * $9 / $4}')
+      rate=$(grep -o "particle-steps/s [0-9.e+-]*" <<<"$out" | cut -d' ' -f2)
+      [ -n "$md" ] && [ -n "$rate" ] || { echo "paired run failed:"; tail -n 5 "$log"; continue; }
+      ratio=$(awk -v a="$rate" -v b="$md" 'BEGIN {printf "%.2f", a / b}')
+      printf "%-18s %-9s %12.4g %-9s %12.4g %9s\n" "$config" "core $cm" "$md" "core $ct" \
+        "$rate" "$ratio"
+    done
+  done
+  exit 0
+fi
 row="%-8s %-18s %5s %9s %6.1f %10.4g %9.3f %12.4g %9s %12.4g\n"
 printf "%-8s %-18s %5s %9s %6s %10s %9s %12s %9s %12s\n" code config procs particles neighb \
   "dt [s]" "wall [s]" "p-steps/s" "tlsph/MD" "tip u_z [m]"
