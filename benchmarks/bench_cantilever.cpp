@@ -17,6 +17,7 @@
 
 #include "tlsph/LargePageAllocator.hpp"
 #include "tlsph/Lattice.hpp"
+#include "tlsph/Prefetch.hpp"
 #include "tlsph/Solver.hpp"
 #ifdef TLSPH_HAVE_MPI
 #include <mpi.h>
@@ -150,6 +151,9 @@ int main(int argc, char** argv) {
     std::cout << "pair arrays: " << (map.advised ? "advised for huge pages" : "not advised")
               << ", the gradient vectors' mapping " << map.hugePageBytes / 1048576 << " of "
               << map.bytes / 1048576 << " MiB on huge pages\n";
+    // Whether the pair loops prefetch their gathers (Prefetch.hpp: out of the last-level cache).
+    std::cout << "gathers prefetched: " << (solver.forces().prefetchGathers() ? "yes" : "no")
+              << " (last-level cache " << lastLevelCacheBytes() / 1048576 << " MiB)\n";
   }
 #ifdef TLSPH_HAVE_MPI
   if (comm) comm->barrier();

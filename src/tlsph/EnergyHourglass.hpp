@@ -50,8 +50,9 @@ class EnergyHourglass {
   // once per particle through the constant moments sum_J c_IJ X_IJ and sum_J c_IJ X_IJ X_IJ^T.
   // With Gradient = true, F holds the displacement gradients H = F - 1 themselves (the
   // tangent's linearised pass, where 1 + dH would round dH off).
-  // `particles`: only these (a distributed run's own), else all.
-  template <bool Gradient = false>
+  // `particles`: only these (a distributed run's own), else all. Gather: prefetch the
+  // neighbours' F ahead (Prefetch.hpp; when F is read from memory).
+  template <bool Gradient = false, bool Gather = false>
   void evaluate(const std::vector<Vec<D>>& u, std::span<const Mat<D>> F, const Mat<D>* P,
                 std::span<Mat<D>> stress, const std::vector<Index>* particles = nullptr) {
     const auto& nb = ref_.neighbours;
@@ -69,6 +70,7 @@ class EnergyHourglass {
         const Index j = nb.neighbour[k];
         prefetchAhead(X);
         prefetchAhead(c);
+        if constexpr (Gather) prefetchGather(F.data(), j);
         const Vec<D>& Xij = *X;
         const Vec<D> HjX = Gradient ? Vec<D>(F[j] * Xij) : Vec<D>(F[j] * Xij - Xij);
         const Vec<D> w = *c * ((ui - u[j]) - 0.5 * HjX);

@@ -138,8 +138,10 @@ class TaylorQuadrature {
   Vec<D> hyperForceOwn(Index i) const { return R_[i] * sum_[i]; }
   // Particle i's row of T_IJ (T[m] for its m-th pair), and one pair's term R_J . T_IJ.
   const Sym* reverseRow(Index i) const { return reverse_.row(i); }
+  template <bool Gather = false>
   Vec<D> hyperForcePair(const Sym* T, Index j) const {
     prefetchAhead(T);
+    if constexpr (Gather) prefetchGather(R_.data(), j);
     return R_[j] * *T;
   }
 

@@ -97,6 +97,11 @@ class TlsphForces {
           reference, materials, materialOfParticle, smoothingLength, viscosity);
       viscousForce_.assign(n, Vec<D>::Zero());
     }
+    // What the force pass (S_J, R_J) and the penalty (F_J) gather, per particle.
+    gatheredPerParticle_ = sizeof(Mat<D>) +
+                           (quadrature_ ? sizeof(typename TaylorQuadrature<D>::SymMatrix) : 0) +
+                           (energyHourglass_ ? sizeof(Mat<D>) : 0);
+    prefetchGathers_ = gathersFromMemory(gatheredPerParticle_ * n);
   }
 
   // A distributed run (issue 11): this rank computes the particles it owns (ascending), and
@@ -112,6 +117,8 @@ class TlsphForces {
       std::erase_if(group, [&](Index i) { return !mine[i]; });
     ownedPassive_ = passive_;
     std::erase_if(ownedPassive_, [&](Index i) { return !mine[i]; });
+    // a rank gathers about its own particles' values (and its halo's)
+    prefetchGathers_ = gathersFromMemory(gatheredPerParticle_ * double(owned.size()));
   }
 
   // Every rank's entries of what observers read (F, P, the hourglass and viscous forces, the
@@ -148,10 +155,15 @@ class TlsphForces {
     const LargeArray<Mat<D>>& PQ = quadrature_ ? quadratureStress_ : P_;
     const std::vector<Index>* owned = comm_ ? &owned_ : nullptr;
     // P^hg of the linear F goes through the linear gradient vectors: its own sum.
-    if (energyHourglass_ && separateHourglassGradient_)
-      energyHourglass_->evaluate(u, hourglassF_, nullptr, stress_, owned);
-    else if (energyHourglass_)
-      energyHourglass_->evaluate(u, F_, PQ.data(), stress_, owned);
+    if (energyHourglass_) {
+      const bool linear = separateHourglassGradient_;
+      const LargeArray<Mat<D>>& Fh = linear ? hourglassF_ : F_;
+      const Mat<D>* P = linear ? nullptr : PQ.data();
+      if (prefetchGathers_)
+        energyHourglass_->template evaluate<false, true>(u, Fh, P, stress_, owned);
+      else
+        energyHourglass_->evaluate(u, Fh, P, stress_, owned);
+    }
     if (comm_) {  // the force pass reads the neighbours' stresses (and hyperstresses)
       if (energyHourglass_) comm_->exchangeHalo(stress_);
       if (!energyHourglass_ || separateHourglassGradient_)
@@ -278,6 +290,12 @@ class TlsphForces {
     return t;
   }
 
+  // Whether the force pass and the penalty prefetch the neighbours' values they gather
+  // (Prefetch.hpp: on when those arrays are larger than twice the last-level cache). Results
+  // are the same either way; the setter is for the tests.
+  bool prefetchGathers() const { return prefetchGathers_; }
+  void prefetchGathers(bool on) { prefetchGathers_ = on; }
+
   // K_I = sum_J k_IJ per particle: the penalty's spring stiffness (empty when it is off).
   const std::vector<double>& hourglassStiffness() const { return hourglassStiffness_; }
 
@@ -368,18 +386,25 @@ class TlsphForces {
   template <bool Taylor>
   void forcePass(const std::vector<Vec<D>>& u, std::vector<Vec<D>>& f, const std::vector<Vec<D>>* v,
                  bool viscous) {
+    prefetchGathers_ ? forcePass<Taylor, true>(u, f, v, viscous)
+                     : forcePass<Taylor, false>(u, f, v, viscous);
+  }
+  template <bool Taylor, bool Gather>
+  void forcePass(const std::vector<Vec<D>>& u, std::vector<Vec<D>>& f, const std::vector<Vec<D>>* v,
+                 bool viscous) {
     if (energyHourglass_ && separateHourglassGradient_)
-      viscous ? accumulateForces<false, true, true, Taylor>(u, f, v)
-              : accumulateForces<false, false, true, Taylor>(u, f, v);
+      viscous ? accumulateForces<false, true, true, Taylor, Gather>(u, f, v)
+              : accumulateForces<false, false, true, Taylor, Gather>(u, f, v);
     else if (ganzenmueller_)
-      viscous ? accumulateForces<true, true, false, Taylor>(u, f, v)
-              : accumulateForces<true, false, false, Taylor>(u, f, v);
+      viscous ? accumulateForces<true, true, false, Taylor, Gather>(u, f, v)
+              : accumulateForces<true, false, false, Taylor, Gather>(u, f, v);
     else
-      viscous ? accumulateForces<false, true, false, Taylor>(u, f, v)
-              : accumulateForces<false, false, false, Taylor>(u, f, v);
+      viscous ? accumulateForces<false, true, false, Taylor, Gather>(u, f, v)
+              : accumulateForces<false, false, false, Taylor, Gather>(u, f, v);
   }
 
-  template <bool Ganzenmueller, bool Viscous, bool SeparateHourglassStress, bool Taylor>
+  template <bool Ganzenmueller, bool Viscous, bool SeparateHourglassStress, bool Taylor,
+            bool Gather>
   void accumulateForces(const std::vector<Vec<D>>& u, std::vector<Vec<D>>& f,
                         const std::vector<Vec<D>>* velocity) {
     const auto& nb = ref_.neighbours;
@@ -410,12 +435,13 @@ class TlsphForces {
       for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k, ++t) {
         const Index j = nb.neighbour[k];
         prefetchAhead(t);
+        if constexpr (Gather) prefetchGather(S.data(), j);
         internal.noalias() -= S[j] * *t;
         if constexpr (SeparateHourglassStress) {
           prefetchAhead(tLinear);
           internal.noalias() -= stress_[j] * *tLinear++;
         }
-        if constexpr (Taylor) internal.noalias() -= q->hyperForcePair(T++, j);
+        if constexpr (Taylor) internal.noalias() -= q->template hyperForcePair<Gather>(T++, j);
         if constexpr (Ganzenmueller || Viscous) {
           prefetchAhead(&ref_.separation[k]);
           const Vec<D>& Xij = ref_.separation[k];
@@ -459,6 +485,8 @@ class TlsphForces {
   SharedRows<Vec<D>> linearGradient_;     // g^lin_IJ (the penalty's own F only)
   std::vector<Vec<D>> linearSum_;         // G^lin_I
   bool separateHourglassGradient_ = false;
+  bool prefetchGathers_ = false;      // set in the constructor (and distribute())
+  double gatheredPerParticle_ = 0.0;  // bytes of S_J (+ R_J) (+ F_J)
   LargeArray<Mat<D>> hourglassF_;
   std::vector<double> hourglassStiffness_;  // K_I
   std::unique_ptr<EnergyHourglass<D>> energyHourglass_;
