@@ -54,7 +54,6 @@ void expectSameForcesWithPrefetch(Quadrature quadrature, GradientCorrection corr
   TlsphForces<D> plain(ref, materials, materialOf, V, hourglass, quadrature);
   TlsphForces<D> prefetching(ref, materials, materialOf, V, hourglass, quadrature);
   EXPECT_FALSE(plain.prefetchGathers());  // a few hundred particles sit in any cache
-  plain.prefetchGathers(false);
   prefetching.prefetchGathers(true);
   std::vector<Vec<D>> a(n), b(n);
   plain.compute(u, a);

@@ -97,11 +97,7 @@ class TlsphForces {
           reference, materials, materialOfParticle, smoothingLength, viscosity);
       viscousForce_.assign(n, Vec<D>::Zero());
     }
-    // What the force pass (S_J, R_J) and the penalty (F_J) gather, per particle.
-    gatheredPerParticle_ = sizeof(Mat<D>) +
-                           (quadrature_ ? sizeof(typename TaylorQuadrature<D>::SymMatrix) : 0) +
-                           (energyHourglass_ ? sizeof(Mat<D>) : 0);
-    prefetchGathers_ = gathersFromMemory(gatheredPerParticle_ * n);
+    prefetchGathers_ = gathersFromMemory(gatheredBytesPerParticle() * n);
   }
 
   // A distributed run (issue 11): this rank computes the particles it owns (ascending), and
@@ -118,7 +114,7 @@ class TlsphForces {
     ownedPassive_ = passive_;
     std::erase_if(ownedPassive_, [&](Index i) { return !mine[i]; });
     // a rank gathers about its own particles' values (and its halo's)
-    prefetchGathers_ = gathersFromMemory(gatheredPerParticle_ * double(owned.size()));
+    prefetchGathers_ = gathersFromMemory(gatheredBytesPerParticle() * double(owned.size()));
   }
 
   // Every rank's entries of what observers read (F, P, the hourglass and viscous forces, the
@@ -300,6 +296,12 @@ class TlsphForces {
   const std::vector<double>& hourglassStiffness() const { return hourglassStiffness_; }
 
  private:
+  // What the force pass (S_J, R_J) and the penalty (F_J) gather, in bytes per particle.
+  double gatheredBytesPerParticle() const {
+    return sizeof(Mat<D>) + (quadrature_ ? sizeof(typename TaylorQuadrature<D>::SymMatrix) : 0) +
+           (energyHourglass_ ? sizeof(Mat<D>) : 0);
+  }
+
   // F_I = 1 + sum_J (u_J - u_I) (x) g_IJ (6.69), for the gradient vectors g given.
   Mat<D> deformationGradientOf(Index i, const std::vector<Vec<D>>& u,
                                const SharedRows<Vec<D>>& gradients) const {
@@ -485,8 +487,7 @@ class TlsphForces {
   SharedRows<Vec<D>> linearGradient_;     // g^lin_IJ (the penalty's own F only)
   std::vector<Vec<D>> linearSum_;         // G^lin_I
   bool separateHourglassGradient_ = false;
-  bool prefetchGathers_ = false;      // set in the constructor (and distribute())
-  double gatheredPerParticle_ = 0.0;  // bytes of S_J (+ R_J) (+ F_J)
+  bool prefetchGathers_ = false;  // set in the constructor (and distribute())
   LargeArray<Mat<D>> hourglassF_;
   std::vector<double> hourglassStiffness_;  // K_I
   std::unique_ptr<EnergyHourglass<D>> energyHourglass_;
