@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "tlsph/Padded.hpp"
 #include "tlsph/Prefetch.hpp"
 #include "tlsph/ReferenceConfiguration.hpp"
 #include "tlsph/ReproducibleSum.hpp"
@@ -37,10 +38,12 @@ class EnergyHourglass {
         sumCX_[i] += c[k] * ref.separation[k];
         sumCXX_[i] += c[k] * ref.separation[k] * ref.separation[k].transpose();
       }
-    // The pass streams only the distinct rows (SharedRows.hpp; X_IJ from the reference's
-    // array unless sharing halves it).
+    // The pass streams only the distinct rows (SharedRows.hpp), X_IJ padded (Padded.hpp).
     c_ = SharedRows<double>(nb, std::move(pairCoefficient));
-    separation_ = SharedRows<Vec<D>>(nb, ref.separation);
+    PairArray<PaddedVec<D>> separation(ref.separation.size());
+    for (std::size_t k = 0; k < separation.size(); ++k)
+      separation[k] = padded<D, 1>(ref.separation[k]);
+    separation_ = SharedRows<PaddedVec<D>>(nb, std::move(separation));
   }
 
   // One pass over the pairs: stress[i] = P[i] + P^hg_i (what the force pass uses; P^hg_i
@@ -50,43 +53,51 @@ class EnergyHourglass {
   // once per particle through the constant moments sum_J c_IJ X_IJ and sum_J c_IJ X_IJ X_IJ^T.
   // With Gradient = true, F holds the displacement gradients H = F - 1 themselves (the
   // tangent's linearised pass, where 1 + dH would round dH off).
+  // u, F, P and stress are plain (Vec<D>, Mat<D>) or padded (Padded.hpp: the force pass's
+  // arrays); the sums run in the width of u.
   // `particles`: only these (a distributed run's own), else all. Gather: prefetch the
   // neighbours' F ahead (Prefetch.hpp; when F is read from memory).
-  template <bool Gradient = false, bool Gather = false>
-  void evaluate(const std::vector<Vec<D>>& u, std::span<const Mat<D>> F, const Mat<D>* P,
-                std::span<Mat<D>> stress, const std::vector<Index>* particles = nullptr) {
+  template <bool Gradient = false, bool Gather = false, class U, class FM, class PM, class SM>
+  void evaluate(std::span<const U> u, std::span<const FM> F, const PM* P, std::span<SM> stress,
+                const std::vector<Index>* particles = nullptr) {
+    constexpr int R = U::RowsAtCompileTime;  // D, or 4 when padded
+    using Row = Eigen::Matrix<double, R, 1>;
+    using Moment = Eigen::Matrix<double, R, D>;
     const auto& nb = ref_.neighbours;
     const Index count = particles ? static_cast<Index>(particles->size()) : ref_.particleCount();
     const Index* list = particles ? particles->data() : nullptr;
 #pragma omp parallel for schedule(static)
     for (Index p = 0; p < count; ++p) {
       const Index i = list ? list[p] : p;
-      const Vec<D> ui = u[i];
-      Vec<D> sum = Vec<D>::Zero();
-      Mat<D> moment = Mat<D>::Zero();
-      const Vec<D>* X = separation_.row(i);
+      const Row ui = u[i];
+      Row sum = Row::Zero();
+      Moment moment = Moment::Zero();
+      const PaddedVec<D>* X = separation_.row(i);
       const double* c = c_.row(i);
       for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k, ++X, ++c) {
         const Index j = nb.neighbour[k];
         prefetchAhead(X);
         prefetchAhead(c);
         if constexpr (Gather) prefetchGather(F.data(), j);
-        const Vec<D>& Xij = *X;
-        const Vec<D> HjX = Gradient ? Vec<D>(F[j] * Xij) : Vec<D>(F[j] * Xij - Xij);
-        const Vec<D> w = *c * ((ui - u[j]) - 0.5 * HjX);
+        const Vec<D> Xij = X->template head<D>();
+        const Row HjX = Gradient ? Row(F[j] * Xij) : Row(F[j] * Xij - X->template head<R>());
+        const Row w = *c * ((ui - u[j]) - 0.5 * HjX);
         sum += w;
         moment.noalias() += w * Xij.transpose();
       }
-      const Mat<D> Hi = Gradient ? F[i] : Mat<D>(F[i] - Mat<D>::Identity());
-      sum -= 0.5 * (Hi * sumCX_[i]);                // sum_J c_IJ e_IJ
-      moment.noalias() -= 0.5 * (Hi * sumCXX_[i]);  // sum_J c_IJ e_IJ (x) X_IJ
+      const auto Fi = F[i].template topRows<D>();
+      const Mat<D> Hi = Gradient ? Mat<D>(Fi) : Mat<D>(Fi - Mat<D>::Identity());
+      Vec<D> sumD = sum.template head<D>();
+      Mat<D> momentD = moment.template topRows<D>();
+      sumD -= 0.5 * (Hi * sumCX_[i]);                // sum_J c_IJ e_IJ
+      momentD.noalias() -= 0.5 * (Hi * sumCXX_[i]);  // sum_J c_IJ e_IJ (x) X_IJ
       // P + P^hg, written as expressions: a Mat = Mat copy here is an out-of-line call once
       // the unit holds enough of them, and that spills the loop's sums to memory
       if (P)
-        stress[i].noalias() = P[i] - 0.5 * moment;
+        stress[i].template topRows<D>().noalias() = P[i].template topRows<D>() - 0.5 * momentD;
       else
-        stress[i].noalias() = -0.5 * moment;
-      spring_[i] = -volume_[i] * sum;  // -sum_J k_IJ e_IJ
+        stress[i].template topRows<D>().noalias() = -0.5 * momentD;
+      spring_[i] = -volume_[i] * sumD;  // -sum_J k_IJ e_IJ
     }
   }
 
@@ -112,11 +123,11 @@ class EnergyHourglass {
     for (Index p = 0; p < count; ++p) {
       const Index i = particles ? (*particles)[p] : p;
       double squares = 0.0;
-      const Vec<D>* X = separation_.row(i);
+      const PaddedVec<D>* X = separation_.row(i);
       const double* c = c_.row(i);
       for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k, ++X, ++c) {
         const Index j = nb.neighbour[k];
-        const Vec<D>& Xij = *X;
+        const Vec<D> Xij = X->template head<D>();
         const Vec<D> e = (u[i] - u[j]) - 0.5 * ((F[i] + F[j]) * Xij - 2.0 * Xij);
         squares += *c * e.squaredNorm();
       }
@@ -127,8 +138,8 @@ class EnergyHourglass {
 
  private:
   const ReferenceConfiguration<D>& ref_;
-  SharedRows<double> c_;           // c_IJ
-  SharedRows<Vec<D>> separation_;  // X_IJ
+  SharedRows<double> c_;                 // c_IJ
+  SharedRows<PaddedVec<D>> separation_;  // X_IJ
   const std::vector<double>& volume_;
   std::vector<Vec<D>> spring_;
   std::vector<Vec<D>> sumCX_;   // sum_J c_IJ X_IJ

@@ -67,9 +67,13 @@ void TangentStiffness<D>::apply(const Eigen::VectorXd& v, Eigen::VectorXd& Kv, P
   if (penalty) {
     // E_hg is quadratic in u: its force at v is K_hg v.
     if (separate_) {
-      penalty_->template evaluate<true>(full_, hourglassH_, nullptr, penaltyStress_);
+      penalty_->template evaluate<true>(
+          std::span<const Vec<D>>(full_), std::span<const Mat<D>>(hourglassH_),
+          static_cast<const Mat<D>*>(nullptr), std::span<Mat<D>>(penaltyStress_));
     } else {
-      penalty_->template evaluate<true>(full_, dF_, dS_.data(), penaltyStress_);
+      penalty_->template evaluate<true>(std::span<const Vec<D>>(full_),
+                                        std::span<const Mat<D>>(dF_), dS_.data(),
+                                        std::span<Mat<D>>(penaltyStress_));
       S = &penaltyStress_;
     }
   }

@@ -79,7 +79,7 @@ TaylorQuadrature<D>::TaylorQuadrature(const ReferenceConfiguration<D>& ref,
   fit_ = SharedRows<Fit>(nb, std::move(fit));
   reverse_ = SharedRows<Sym>(nb, std::move(reverse));
   G_.assign(n, SymMatrix::Zero());
-  R_.assign(n, SymMatrix::Zero());
+  R_.assign(n, PaddedSymMatrix::Zero());
   force_.assign(n, Vec<D>::Zero());
 }
 

@@ -33,6 +33,7 @@
 #include "materials/Material.hpp"
 #include "tlsph/Communicator.hpp"
 #include "tlsph/OrderedSum.hpp"
+#include "tlsph/Padded.hpp"
 #include "tlsph/Prefetch.hpp"
 #include "tlsph/ReferenceConfiguration.hpp"
 #include "tlsph/SharedRows.hpp"
@@ -49,6 +50,7 @@ class TaylorQuadrature {
   static constexpr int P = D * (D + 1) / 2;
   using Sym = Eigen::Matrix<double, P, 1>;
   using SymMatrix = Eigen::Matrix<double, D, P>;
+  using PaddedSymMatrix = PaddedMat<D, P>;  // R_I as the force pass gathers it (Padded.hpp)
   // A pair's whole fit, [g_IJ, S_IJ]: the gradient vector and the second-derivative vector in
   // one record, so that the F pass reads one stream and multiplies it as one row (gradients()).
   using Fit = Eigen::Matrix<double, 1, D + P>;
@@ -118,7 +120,7 @@ class TaylorQuadrature {
       const Gradients G = unpack(Gs);
       for (int a = 0; a < D; ++a)
         sigma[a] = weight_[i] * stressOf(i, G[a]);
-      R_[i] = symmetric(sigma);
+      R_[i].template topRows<D>() = symmetric(sigma);
       return Pq;
     }
     const Gradients A = unpack(F.transpose() * Gs);  // F^T G_a
@@ -127,7 +129,7 @@ class TaylorQuadrature {
       sigma[a] = weight_[i] * stressOf(i, A[a]);
       Pq.noalias() += G[a] * sigma[a];
     }
-    R_[i].noalias() = F * symmetric(sigma);  // R_a = F sigma_a, stored symmetric
+    R_[i].template topRows<D>().noalias() = F * symmetric(sigma);  // R_a = F sigma_a (symmetric)
     return Pq;
   }
   // Distributed runs: the halo's hyperstresses (read by the force pass), and every rank's
@@ -135,11 +137,11 @@ class TaylorQuadrature {
   void exchangeHalo(Communicator& comm) { comm.exchangeHalo(R_); }
   void gatherAll(Communicator& comm) { comm.gatherAll(G_); }
 
-  Vec<D> hyperForceOwn(Index i) const { return R_[i] * sum_[i]; }
+  PaddedVec<D> hyperForceOwn(Index i) const { return R_[i] * sum_[i]; }
   // Particle i's row of T_IJ (T[m] for its m-th pair), and one pair's term R_J . T_IJ.
   const Sym* reverseRow(Index i) const { return reverse_.row(i); }
   template <bool Gather = false>
-  Vec<D> hyperForcePair(const Sym* T, Index j) const {
+  PaddedVec<D> hyperForcePair(const Sym* T, Index j) const {
     prefetchAhead(T);
     if constexpr (Gather) prefetchGather(R_.data(), j);
     return R_[j] * *T;
@@ -172,7 +174,7 @@ class TaylorQuadrature {
         if (!small) dPq.noalias() += dG[a] * sigma + G[a] * dsigma;
         R[a] = dHi * sigma + Fi * dsigma;
       }
-      R_[i] = symmetric(R);
+      R_[i].template topRows<D>() = symmetric(R);
       dstress[i] += dPq;
     }
     hyperForce(R_);
@@ -227,16 +229,16 @@ class TaylorQuadrature {
     return Rs;
   }
 
-  void hyperForce(std::span<const SymMatrix> R) {
+  void hyperForce(std::span<const PaddedSymMatrix> R) {
     const auto& nb = ref_.neighbours;
     const Index n = ref_.particleCount();
 #pragma omp parallel for schedule(static)
     for (Index i = 0; i < n; ++i) {
-      Vec<D> f = R[i] * sum_[i];
+      PaddedVec<D> f = R[i] * sum_[i];
       const Sym* T = reverse_.row(i);
       for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k, ++T)
         f.noalias() -= R[nb.neighbour[k]] * *T;
-      force_[i] = volume_[i] * f;
+      force_[i] = volume_[i] * f.template head<D>();
     }
   }
 
@@ -248,7 +250,7 @@ class TaylorQuadrature {
   std::vector<double> weight_, lambda_, mu_;
   std::vector<std::uint8_t> smallStrain_;  // linear-elastic material: e_a = sym(G_a)
   std::vector<SymMatrix> G_;               // grad grad u, symmetric storage
-  LargeArray<SymMatrix> R_;                // hyperstress, symmetric storage (gathered)
+  LargeArray<PaddedSymMatrix> R_;          // hyperstress, symmetric storage, padded (gathered)
   std::vector<Vec<D>> force_;
 };
 

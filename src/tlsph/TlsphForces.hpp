@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <type_traits>
 #include <variant>
 #include <vector>
@@ -24,6 +25,7 @@
 #include "tlsph/GanzenmuellerHourglass.hpp"
 #include "tlsph/HourglassStiffness.hpp"
 #include "tlsph/OrderedSum.hpp"
+#include "tlsph/Padded.hpp"
 #include "tlsph/PairTerms.hpp"
 #include "tlsph/Prefetch.hpp"
 #include "tlsph/ReferenceConfiguration.hpp"
@@ -68,7 +70,7 @@ class TlsphForces {
     if (quadrature == Quadrature::Taylor) {
       quadrature_ = std::make_unique<TaylorQuadrature<D>>(reference, materials, materialOfParticle,
                                                           volume, isPassive);
-      quadratureStress_.assign(n, Mat<D>::Zero());
+      quadratureStress_.assign(n, PaddedMat<D>::Zero());
     }
     if (hourglass.enabled()) {
       auto c = hourglassPairCoefficients(reference, materials, materialOfParticle, volume,
@@ -85,7 +87,12 @@ class TlsphForces {
       }
       if (hourglass.form == HourglassForm::Energy) {
         energyHourglass_ = std::make_unique<EnergyHourglass<D>>(reference, std::move(c), volume);
-        stress_.assign(n, Mat<D>::Zero());
+        stress_.assign(n, PaddedMat<D>::Zero());
+        if constexpr (D == 3) {  // the penalty's gathered u and F, padded
+          paddedU_.assign(n, PaddedVec<D>::Zero());
+          paddedPenaltyF_.assign(n, padded<D, D>(Mat<D>::Identity()));
+          copyPenaltyF_ = !separateHourglassGradient_;
+        }
         if (separateHourglassGradient_) linearReverseGradients(volume);
       } else {
         ganzenmueller_ = std::make_unique<GanzenmuellerHourglass<D>>(std::move(c));
@@ -144,26 +151,31 @@ class TlsphForces {
   void compute(const std::vector<Vec<D>>& u, std::vector<Vec<D>>& f,
                const std::vector<Vec<D>>* v = nullptr) {
     quadrature_ ? stressPass<true>(u) : stressPass<false>(u);
-    // The penalty reads the neighbours' F (the one it compares with).
-    if (comm_ && hourglass_.enabled())
-      comm_->exchangeHalo(separateHourglassGradient_ ? hourglassF_ : F_);
-    // What the force pass sends through g_IJ: P (+ P^q) (+ P^hg of the same F).
-    const LargeArray<Mat<D>>& PQ = quadrature_ ? quadratureStress_ : P_;
-    const std::vector<Index>* owned = comm_ ? &owned_ : nullptr;
+    // The penalty reads the neighbours' F (the one it compares with; padded for the energy form).
+    if (comm_ && hourglass_.enabled()) {
+      if (energyHourglass_)
+        comm_->exchangeHalo(penaltyGradient());
+      else
+        comm_->exchangeHalo(separateHourglassGradient_ ? hourglassF_ : F_);
+    }
     // P^hg of the linear F goes through the linear gradient vectors: its own sum.
     if (energyHourglass_) {
-      const bool linear = separateHourglassGradient_;
-      const LargeArray<Mat<D>>& Fh = linear ? hourglassF_ : F_;
-      const Mat<D>* P = linear ? nullptr : PQ.data();
-      if (prefetchGathers_)
-        energyHourglass_->template evaluate<false, true>(u, Fh, P, stress_, owned);
+      // what the force pass sends through g_IJ: P (+ P^q) + P^hg of the same F
+      if (separateHourglassGradient_)
+        hourglassStress(u, static_cast<const Mat<D>*>(nullptr));
+      else if (quadrature_)
+        hourglassStress(u, quadratureStress_.data());
       else
-        energyHourglass_->evaluate(u, Fh, P, stress_, owned);
+        hourglassStress(u, P_.data());
     }
     if (comm_) {  // the force pass reads the neighbours' stresses (and hyperstresses)
       if (energyHourglass_) comm_->exchangeHalo(stress_);
-      if (!energyHourglass_ || separateHourglassGradient_)
-        comm_->exchangeHalo(quadrature_ ? quadratureStress_ : P_);
+      if (!energyHourglass_ || separateHourglassGradient_) {
+        if (quadrature_)
+          comm_->exchangeHalo(quadratureStress_);
+        else
+          comm_->exchangeHalo(P_);
+      }
       if (quadrature_) quadrature_->exchangeHalo(*comm_);
     }
     const bool viscous = viscosity_ && v != nullptr;
@@ -229,7 +241,11 @@ class TlsphForces {
     const TaylorQuadrature<D>* q = quadrature_.get();
     const bool taylor = q != nullptr;
     constexpr double S = sizeof(typename TaylorQuadrature<D>::Sym),
-                     SM = sizeof(typename TaylorQuadrature<D>::SymMatrix);
+                     SM = sizeof(typename TaylorQuadrature<D>::SymMatrix),
+                     PSM = sizeof(typename TaylorQuadrature<D>::PaddedSymMatrix);
+    // padded (Padded.hpp): P + P^q, P + P^hg, and in 3D the penalty's u and F
+    constexpr double PV = sizeof(PaddedVec<D>), PM = sizeof(PaddedMat<D>);
+    const double paddedCopies = D == 3 && energyHourglass_ ? 1.0 : 0.0;
     const double pairs = std::max<double>(1.0, ref_.neighbours.pairCount());
     Traffic t;
     // each shared stream: its stored bytes once, and a row start per particle
@@ -249,27 +265,31 @@ class TlsphForces {
       stream(q->fitRows().storedBytes(), V + S);
     else
       stream(correctedGradient_.storedBytes(), V);
-    t.perParticle += 2 * I + V + 2 * M + (taylor ? M + 2 * SM + 3 * d : 0.0);
-    if (separateHourglassGradient_) {  // the penalty's own F through g^lin_IJ
+    t.perParticle += 2 * I + V + 2 * M + (taylor ? PM + SM + PSM + 3 * d : 0.0);
+    t.perParticle += paddedCopies * PM;  // the padded F the penalty gathers
+    if (separateHourglassGradient_) {    // the penalty's own F through g^lin_IJ
       pairIndices();
       stream(linearGradient_.storedBytes(), V);
       t.perParticle += I + V + M;
     }
     if (energyHourglass_) {  // j, X_IJ, c_IJ; u_I, F_I, P_I, moments, V_I; writes P + P^hg, spring
       pairIndices();
-      stream(energyHourglass_->storedPairBytes(), V + d);
-      t.perParticle += I;  // the second row start
-      t.perParticle += I + V + M + (separateHourglassGradient_ ? 0.0 : M) + M + V + V + M + d;
+      stream(energyHourglass_->storedPairBytes(), PV + d);
+      t.perParticle += paddedCopies * (V + PV);  // u padded
+      t.perParticle += I;                        // the second row start
+      const double P = separateHourglassGradient_ ? 0.0 : taylor ? PM : M;
+      t.perParticle += I + PV + PM + P + M + V + V + PM + d;
     }
     // Force pass: j, t_IJ (+ T_IJ) (+ t^lin_IJ); S_I, G_I (+ R_I, Sum_I), V_I; writes f.
     pairIndices();
     stream(reverseGradient_.storedBytes(), V);
     if (taylor) stream(q->reverseRows().storedBytes(), S);
     if (separateHourglassGradient_) stream(linearReverse_.storedBytes(), V);
-    t.perParticle += I + M + V + (taylor ? SM + S : 0.0) + d + V;
-    if (ganzenmueller_ || viscosity_) t.perParticle += V;    // u_I for x_IJ
-    if (separateHourglassGradient_) t.perParticle += M + V;  // P^hg_I, G^lin_I
-    if (energyHourglass_) t.perParticle += V;                // the spring force
+    const bool paddedS = (energyHourglass_ && !separateHourglassGradient_) || taylor;
+    t.perParticle += I + (paddedS ? PM : M) + V + (taylor ? PSM + S : 0.0) + d + V;
+    if (ganzenmueller_ || viscosity_) t.perParticle += V;     // u_I for x_IJ
+    if (separateHourglassGradient_) t.perParticle += PM + V;  // P^hg_I, G^lin_I
+    if (energyHourglass_) t.perParticle += V;                 // the spring force
     // (the textbook form and the viscosity stream their per-pair arrays whole)
     auto whole = [&](double bytes) {
       t.perPair += bytes;
@@ -298,8 +318,9 @@ class TlsphForces {
  private:
   // What the force pass (S_J, R_J) and the penalty (F_J) gather, in bytes per particle.
   double gatheredBytesPerParticle() const {
-    return sizeof(Mat<D>) + (quadrature_ ? sizeof(typename TaylorQuadrature<D>::SymMatrix) : 0) +
-           (energyHourglass_ ? sizeof(Mat<D>) : 0);
+    return sizeof(PaddedMat<D>) +
+           (quadrature_ ? sizeof(typename TaylorQuadrature<D>::PaddedSymMatrix) : 0) +
+           (energyHourglass_ ? sizeof(PaddedMat<D>) : 0);
   }
 
   // F_I = 1 + sum_J (u_J - u_I) (x) g_IJ (6.69), for the gradient vectors g given.
@@ -359,17 +380,55 @@ class TlsphForces {
       }
       const Mat<D> F = Mat<D>::Identity() + gradU;  // (6.69)
       F_[i] = F;
+      if constexpr (D == 3)
+        if (copyPenaltyF_) paddedPenaltyF_[i].template topRows<D>() = F;
       if constexpr (!std::is_void_v<Model>) {
         const Mat<D> P = firstPiolaKirchhoff<D>(*model, F);
         P_[i] = P;
-        if constexpr (Taylor) quadratureStress_[i] = P + q->stressAt(i, F, Gs);
+        if constexpr (Taylor)
+          quadratureStress_[i].template topRows<D>() = P + q->stressAt(i, F, Gs);
       }
     }
     if (separateHourglassGradient_) {
 #pragma omp parallel for schedule(static)
-      for (Index p = 0; p < count; ++p)
-        hourglassF_[group[p]] = deformationGradientOf(group[p], u, linearGradient_);
+      for (Index p = 0; p < count; ++p) {
+        const Index i = group[p];
+        hourglassF_[i] = deformationGradientOf(i, u, linearGradient_);
+        if constexpr (D == 3)
+          if (energyHourglass_) paddedPenaltyF_[i].template topRows<D>() = hourglassF_[i];
+      }
     }
+  }
+
+  // The F the energy penalty gathers: in 3D a padded copy (Padded.hpp) of F or of the linear
+  // F, written by the F pass; in 2D that F itself.
+  LargeArray<PaddedMat<D>>& penaltyGradient() {
+    if constexpr (D == 3)
+      return paddedPenaltyF_;
+    else
+      return separateHourglassGradient_ ? hourglassF_ : F_;
+  }
+
+  // stress_ = P + P^hg (P^hg alone when P is null) and the springs (EnergyHourglass), reading
+  // u and F padded in 3D.
+  template <class PM>
+  void hourglassStress(const std::vector<Vec<D>>& u, const PM* P) {
+    const std::vector<Index>* owned = comm_ ? &owned_ : nullptr;
+    std::span<const PaddedVec<D>> uh;
+    if constexpr (D == 3) {
+      const Index n = ref_.particleCount();  // the halo's as well
+#pragma omp parallel for schedule(static)
+      for (Index i = 0; i < n; ++i)
+        paddedU_[i].template head<D>() = u[i];
+      uh = paddedU_;
+    } else {
+      uh = u;
+    }
+    std::span<const PaddedMat<D>> F = penaltyGradient();
+    if (prefetchGathers_)
+      energyHourglass_->template evaluate<false, true>(uh, F, P, std::span(stress_), owned);
+    else
+      energyHourglass_->evaluate(uh, F, P, std::span(stress_), owned);
   }
 
   // t^lin_IJ = (V_J / V_I) g^lin_JI and G^lin_I, for the energy penalty on the linear F when
@@ -391,40 +450,51 @@ class TlsphForces {
     prefetchGathers_ ? forcePass<Taylor, true>(u, f, v, viscous)
                      : forcePass<Taylor, false>(u, f, v, viscous);
   }
+  // The stress the force pass sends through the gradient vectors: P (+ P^q), or that plus
+  // P^hg (or P^hg alone through the linear vectors), padded but for P alone.
   template <bool Taylor, bool Gather>
   void forcePass(const std::vector<Vec<D>>& u, std::vector<Vec<D>>& f, const std::vector<Vec<D>>* v,
                  bool viscous) {
-    if (energyHourglass_ && separateHourglassGradient_)
-      viscous ? accumulateForces<false, true, true, Taylor, Gather>(u, f, v)
-              : accumulateForces<false, false, true, Taylor, Gather>(u, f, v);
-    else if (ganzenmueller_)
-      viscous ? accumulateForces<true, true, false, Taylor, Gather>(u, f, v)
-              : accumulateForces<true, false, false, Taylor, Gather>(u, f, v);
+    if (energyHourglass_ && !separateHourglassGradient_)
+      forcePass<Taylor, Gather>(stress_, u, f, v, viscous);
+    else if (Taylor)
+      forcePass<Taylor, Gather>(quadratureStress_, u, f, v, viscous);
     else
-      viscous ? accumulateForces<false, true, false, Taylor, Gather>(u, f, v)
-              : accumulateForces<false, false, false, Taylor, Gather>(u, f, v);
+      forcePass<Taylor, Gather>(P_, u, f, v, viscous);
+  }
+  template <bool Taylor, bool Gather, class SM>
+  void forcePass(const LargeArray<SM>& S, const std::vector<Vec<D>>& u, std::vector<Vec<D>>& f,
+                 const std::vector<Vec<D>>* v, bool viscous) {
+    if (energyHourglass_ && separateHourglassGradient_)
+      viscous ? accumulateForces<false, true, true, Taylor, Gather>(S, u, f, v)
+              : accumulateForces<false, false, true, Taylor, Gather>(S, u, f, v);
+    else if (ganzenmueller_)
+      viscous ? accumulateForces<true, true, false, Taylor, Gather>(S, u, f, v)
+              : accumulateForces<true, false, false, Taylor, Gather>(S, u, f, v);
+    else
+      viscous ? accumulateForces<false, true, false, Taylor, Gather>(S, u, f, v)
+              : accumulateForces<false, false, false, Taylor, Gather>(S, u, f, v);
   }
 
+  // The sums run in the padded width (Padded.hpp); an unpadded S (P alone) adds to the top D
+  // rows.
   template <bool Ganzenmueller, bool Viscous, bool SeparateHourglassStress, bool Taylor,
-            bool Gather>
-  void accumulateForces(const std::vector<Vec<D>>& u, std::vector<Vec<D>>& f,
-                        const std::vector<Vec<D>>* velocity) {
+            bool Gather, class SM>
+  void accumulateForces(const LargeArray<SM>& S, const std::vector<Vec<D>>& u,
+                        std::vector<Vec<D>>& f, const std::vector<Vec<D>>* velocity) {
+    constexpr int R = SM::RowsAtCompileTime;
     const auto& nb = ref_.neighbours;
     // All particles, or (distributed) the owned ones.
     const Index count = comm_ ? static_cast<Index>(owned_.size()) : ref_.particleCount();
     const Index* owned = comm_ ? owned_.data() : nullptr;
-    // The stress the force pass sends through the gradient vectors: P (+ P^q), or that plus
-    // P^hg (or P^hg alone through the linear vectors).
-    const LargeArray<Mat<D>>& S = energyHourglass_ && !SeparateHourglassStress ? stress_
-                                  : Taylor                                     ? quadratureStress_
-                                                                               : P_;
     const LargeArray<Mat<D>>& Fh = separateHourglassGradient_ ? hourglassF_ : F_;
     [[maybe_unused]] const TaylorQuadrature<D>* q = quadrature_.get();
 #pragma omp parallel for schedule(static)
     for (Index p = 0; p < count; ++p) {
       const Index i = owned ? owned[p] : p;
       // (6.70) as a force: f_I = V_I (S_I G_I - sum_J S_J t_IJ)
-      Vec<D> internal = S[i] * ref_.correctedGradientSum[i];
+      PaddedVec<D> internal = PaddedVec<D>::Zero();
+      internal.template head<R>().noalias() = S[i] * ref_.correctedGradientSum[i];
       Vec<D> hourglass = Vec<D>::Zero(), viscous = Vec<D>::Zero();
       const Vec<D> ui = u[i];
       if constexpr (SeparateHourglassStress) internal += stress_[i] * linearSum_[i];
@@ -438,7 +508,7 @@ class TlsphForces {
         const Index j = nb.neighbour[k];
         prefetchAhead(t);
         if constexpr (Gather) prefetchGather(S.data(), j);
-        internal.noalias() -= S[j] * *t;
+        internal.template head<R>().noalias() -= S[j] * *t;
         if constexpr (SeparateHourglassStress) {
           prefetchAhead(tLinear);
           internal.noalias() -= stress_[j] * *tLinear++;
@@ -453,7 +523,7 @@ class TlsphForces {
             viscous += viscosity_->pair(k, xij, (*velocity)[i] - (*velocity)[j]);
         }
       }
-      Vec<D> total = volume_[i] * internal;
+      Vec<D> total = volume_[i] * internal.template head<D>();
       if (energyHourglass_) total += energyHourglass_->springForce(i);
       if constexpr (Ganzenmueller) {
         hourglassForce_[i] = volume_[i] * hourglass;
@@ -480,7 +550,11 @@ class TlsphForces {
   // Per particle, gathered by the pair loops at the neighbours' indices: huge pages as well.
   LargeArray<Mat<D>> F_;
   LargeArray<Mat<D>> P_;
-  LargeArray<Mat<D>> stress_;             // P + P^hg (energy form only; P^hg alone on the linear F)
+  LargeArray<PaddedMat<D>> stress_;  // P + P^hg (energy form only; P^hg alone on the linear F)
+  // 3D, energy form: u and the penalty's F padded for its pass (Padded.hpp)
+  LargeArray<PaddedVec<D>> paddedU_;
+  LargeArray<PaddedMat<D>> paddedPenaltyF_;
+  bool copyPenaltyF_ = false;  // the F pass writes paddedPenaltyF_ (else the linear F's pass)
   SharedRows<Vec<D>> reverseGradient_;    // t_IJ
   SharedRows<Vec<D>> correctedGradient_;  // g_IJ (nodal quadrature, passive particles)
   SharedRows<Vec<D>> linearReverse_;      // t^lin_IJ (energy penalty on the linear F only)
@@ -492,7 +566,7 @@ class TlsphForces {
   std::vector<double> hourglassStiffness_;  // K_I
   std::unique_ptr<EnergyHourglass<D>> energyHourglass_;
   std::unique_ptr<TaylorQuadrature<D>> quadrature_;
-  LargeArray<Mat<D>> quadratureStress_;  // P + P^q
+  LargeArray<PaddedMat<D>> quadratureStress_;  // P + P^q
   std::unique_ptr<GanzenmuellerHourglass<D>> ganzenmueller_;
   std::unique_ptr<ArtificialViscosity<D>> viscosity_;
   std::vector<Vec<D>> hourglassForce_;
