@@ -111,26 +111,31 @@ class TaylorQuadrature {
       Gs.row(a) = rows[a].template tail<P>();
     }
   }
-  Mat<D> stressAt(Index i, const Mat<D>& F, const SymMatrix& Gs) {
-    if (weight_[i] == 0.0) return Mat<D>::Zero();  // R_i stays zero
+  // P^q_I (padded, Padded.hpp), keeping G_I and the hyperstress R_I.
+  PaddedMat<D> stressAt(Index i, const Mat<D>& F, const SymMatrix& Gs) {
+    if (weight_[i] == 0.0) return PaddedMat<D>::Zero();  // R_i stays zero
     G_[i] = Gs;
     Gradients sigma;
-    Mat<D> Pq = Mat<D>::Zero();
     if (smallStrain_[i]) {
       const Gradients G = unpack(Gs);
       for (int a = 0; a < D; ++a)
         sigma[a] = weight_[i] * stressOf(i, G[a]);
       R_[i].template topRows<D>() = symmetric(sigma);
+      return PaddedMat<D>::Zero();
+    }
+    if constexpr (D == 3) {
+      return paddedStressAt(i, F, Gs);
+    } else {
+      const Gradients A = unpack(F.transpose() * Gs);  // F^T G_a
+      const Gradients G = unpack(Gs);
+      Mat<D> Pq = Mat<D>::Zero();
+      for (int a = 0; a < D; ++a) {
+        sigma[a] = weight_[i] * stressOf(i, A[a]);
+        Pq.noalias() += G[a] * sigma[a];
+      }
+      R_[i].noalias() = F * symmetric(sigma);  // R_a = F sigma_a (symmetric)
       return Pq;
     }
-    const Gradients A = unpack(F.transpose() * Gs);  // F^T G_a
-    const Gradients G = unpack(Gs);
-    for (int a = 0; a < D; ++a) {
-      sigma[a] = weight_[i] * stressOf(i, A[a]);
-      Pq.noalias() += G[a] * sigma[a];
-    }
-    R_[i].template topRows<D>().noalias() = F * symmetric(sigma);  // R_a = F sigma_a (symmetric)
-    return Pq;
   }
   // Distributed runs: the halo's hyperstresses (read by the force pass), and every rank's
   // second gradients (read by the energy and the probes).
@@ -212,6 +217,49 @@ class TaylorQuadrature {
   }
 
  private:
+  // Column (a, b) of the symmetric storage (a, b in either order).
+  static constexpr int sym(int a, int b) {
+    return a <= b ? a * D - a * (a - 1) / 2 + (b - a) : sym(b, a);
+  }
+
+  // stressAt in 3D on padded columns: a column of F^T G_a, of G_a sigma_a and of F [sigma] is
+  // one 4-wide multiply-add per term (Eigen splits a 3-row column into a 2-wide and a scalar
+  // one); the scalar work is only sigma_a = w C0 : sym(A_a) from the entries of A.
+  PaddedMat<D> paddedStressAt(Index i, const Mat<D>& F, const SymMatrix& Gs) {
+    const PaddedMat<D, D> Ft = padded<D, D>(Mat<D>(F.transpose()));
+    const PaddedMat<D, P> Gp = padded<D, P>(Gs);
+    PaddedMat<D, P> A;  // column (a, b) = F^T G_a(:, b) = A_a(:, b)
+    A.noalias() = Ft.lazyProduct(Gs);
+    const double lambda = weight_[i] * lambda_[i], mu = weight_[i] * mu_[i];
+    Gradients sigma;  // sigma_a = lambda tr(A_a) 1 + mu (A_a + A_a^T)
+#pragma GCC unroll 3
+    for (int a = 0; a < D; ++a) {
+      double trace = 0.0;
+#pragma GCC unroll 3
+      for (int b = 0; b < D; ++b)
+        trace += A(b, sym(a, b));
+#pragma GCC unroll 3
+      for (int b = 0; b < D; ++b)
+#pragma GCC unroll 3
+        for (int c = b; c < D; ++c) {
+          const double s =
+              mu * (A(b, sym(a, c)) + A(c, sym(a, b))) + (b == c ? lambda * trace : 0.0);
+          sigma[a](b, c) = s;
+          sigma[a](c, b) = s;
+        }
+    }
+    PaddedMat<D> Pq = PaddedMat<D>::Zero();  // sum_a G_a sigma_a, column c
+#pragma GCC unroll 3
+    for (int c = 0; c < D; ++c)
+#pragma GCC unroll 3
+      for (int a = 0; a < D; ++a)
+#pragma GCC unroll 3
+        for (int b = 0; b < D; ++b)
+          Pq.col(c).noalias() += Gp.col(sym(a, b)) * sigma[a](b, c);
+    R_[i].noalias() = padded<D, D>(F).lazyProduct(symmetric(sigma));  // R_a = F sigma_a
+    return Pq;
+  }
+
   // C0 : sym(A)
   Mat<D> stressOf(Index i, const Mat<D>& A) const {
     const Mat<D> e = 0.5 * (A + A.transpose());

@@ -385,8 +385,11 @@ class TlsphForces {
       if constexpr (!std::is_void_v<Model>) {
         const Mat<D> P = firstPiolaKirchhoff<D>(*model, F);
         P_[i] = P;
-        if constexpr (Taylor)
-          quadratureStress_[i].template topRows<D>() = P + q->stressAt(i, F, Gs);
+        if constexpr (Taylor) {
+          PaddedMat<D> S = q->stressAt(i, F, Gs);  // P^q
+          S.template topRows<D>() += P;
+          quadratureStress_[i] = S;
+        }
       }
     }
     if (separateHourglassGradient_) {
