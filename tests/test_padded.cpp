@@ -1,8 +1,8 @@
 // The pair loops' padded values (Padded.hpp, issue 12): padding adds a zero fourth row and is
-// nothing in 2D; and the force pass and the energy penalty, which gather padded S_J, R_J, F_J,
-// u_J and X_IJ, give the force of the tangent's own loops, which use the plain D x D values:
-// for the linear-elastic material the force (internal, energy penalty on either F, quadrature
-// correction) is linear in u, so f(u) = -K u up to rounding.
+// nothing in 2D, transposing keeps the fourth row zero; and the force pass and the energy penalty,
+// which gather padded S_J, R_J, F_J, u_J and X_IJ, give the force of the tangent's own loops, which
+// use the plain D x D values: for the linear-elastic material the force (internal, energy penalty
+// on either F, quadrature correction) is linear in u, so f(u) = -K u up to rounding.
 #include <gtest/gtest.h>
 
 #include <type_traits>
@@ -30,6 +30,19 @@ TEST(Padded, AddsAZeroFourthRow) {
   EXPECT_EQ(p.row(3).squaredNorm(), 0.0);
   const PaddedVec<3> v = padded<3, 1>(Vec<3>(1, 2, 3));
   EXPECT_EQ(v, Eigen::Vector4d(1, 2, 3, 0));
+}
+
+// transposed() shuffles registers in 3D (AVX): every entry must land where Eigen's transpose
+// puts it, and the fourth row stay zero.
+TEST(Padded, TransposedIsTheTransposeWithAZeroFourthRow) {
+  Mat<3> m;
+  m << 1, 2, 3, 4, 5, 6, 7, 8, 9;
+  const PaddedMat<3> t = transposed<3>(padded<3, 3>(m));
+  EXPECT_EQ(Mat<3>(t.topRows<3>()), Mat<3>(m.transpose()));
+  EXPECT_EQ(t.row(3).squaredNorm(), 0.0);
+  Mat<2> m2;
+  m2 << 1, 2, 3, 4;
+  EXPECT_EQ(transposed<2>(m2), Mat<2>(m2.transpose()));
 }
 
 struct Case {

@@ -91,7 +91,7 @@ class TaylorQuadrature {
   // [grad u | Gs] = sum_J (u_J - u_I) (x) [g_IJ, S_IJ] (6.69 and the fit's second
   // derivatives): row a accumulates du_a [g_IJ, S_IJ], one (D + P)-wide multiply-add per row
   // and pair, which vectorises across the row (measured 8-11 % faster per step in 3D than the
-  // separate D x D and D x P products, issue 12).
+  // separate D x D and D x P products, issue 12). 2D; 3D: paddedGradients.
   void gradients(Index i, const std::vector<Vec<D>>& u, Mat<D>& gradU, SymMatrix& Gs) const {
     const auto& nb = ref_.neighbours;
     std::array<Fit, D> rows;
@@ -111,32 +111,23 @@ class TaylorQuadrature {
       Gs.row(a) = rows[a].template tail<P>();
     }
   }
-  // P^q_I (padded, Padded.hpp), keeping G_I and the hyperstress R_I.
-  PaddedMat<D> stressAt(Index i, const Mat<D>& F, const SymMatrix& Gs) {
-    if (weight_[i] == 0.0) return PaddedMat<D>::Zero();  // R_i stays zero
+  // P^q_I, keeping G_I and the hyperstress R_I (2D; 3D: paddedStressAt).
+  Mat<D> stressAt(Index i, const Mat<D>& F, const SymMatrix& Gs) requires(D == 2) {
+    if (weight_[i] == 0.0) return Mat<D>::Zero();  // R_i stays zero
     G_[i] = Gs;
+    if (smallStrain_[i]) return smallStrainHyperstress(i, Gs);
+    const Gradients A = unpack(F.transpose() * Gs);  // F^T G_a
+    const Gradients G = unpack(Gs);
     Gradients sigma;
-    if (smallStrain_[i]) {
-      const Gradients G = unpack(Gs);
-      for (int a = 0; a < D; ++a)
-        sigma[a] = weight_[i] * stressOf(i, G[a]);
-      R_[i].template topRows<D>() = symmetric(sigma);
-      return PaddedMat<D>::Zero();
+    Mat<D> Pq = Mat<D>::Zero();
+    for (int a = 0; a < D; ++a) {
+      sigma[a] = weight_[i] * stressOf(i, A[a]);
+      Pq.noalias() += G[a] * sigma[a];
     }
-    if constexpr (D == 3) {
-      return paddedStressAt(i, F, Gs);
-    } else {
-      const Gradients A = unpack(F.transpose() * Gs);  // F^T G_a
-      const Gradients G = unpack(Gs);
-      Mat<D> Pq = Mat<D>::Zero();
-      for (int a = 0; a < D; ++a) {
-        sigma[a] = weight_[i] * stressOf(i, A[a]);
-        Pq.noalias() += G[a] * sigma[a];
-      }
-      R_[i].noalias() = F * symmetric(sigma);  // R_a = F sigma_a (symmetric)
-      return Pq;
-    }
+    R_[i].noalias() = F * symmetric(sigma);  // R_a = F sigma_a (symmetric)
+    return Pq;
   }
+
   // Distributed runs: the halo's hyperstresses (read by the force pass), and every rank's
   // second gradients (read by the energy and the probes).
   void exchangeHalo(Communicator& comm) { comm.exchangeHalo(R_); }
@@ -216,20 +207,40 @@ class TaylorQuadrature {
     });
   }
 
- private:
-  // Column (a, b) of the symmetric storage (a, b in either order).
-  static constexpr int sym(int a, int b) {
-    return a <= b ? a * D - a * (a - 1) / 2 + (b - a) : sym(b, a);
+  // The pair loops written with #pragma GCC unroll come last: clang-format 14 loses the class
+  // scope after them and would split the short functions above.
+  // In 3D the same sums on padded columns (Padded.hpp): M = [grad u | Gs], column m
+  // accumulating (u_J - u_I) times entry m of [g_IJ, S_IJ], one 4-wide multiply-add per column
+  // and pair with u gathered as one 256-bit word (the rows above split into 2-wide and scalar
+  // ones, issue 12); F, grad grad u and P^q come out padded for paddedStressAt.
+  using FitSum = PaddedMat<D, D + P>;
+  FitSum paddedGradients(Index i, std::span<const PaddedVec<D>> u) const {
+    const auto& nb = ref_.neighbours;
+    FitSum M = FitSum::Zero();  // a local: GCC keeps it in registers through the loop
+    const PaddedVec<D> ui = u[i];
+    const Fit* fit = fit_.row(i);
+    for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k, ++fit) {
+      prefetchAhead(fit);
+      const PaddedVec<D> du = u[nb.neighbour[k]] - ui;
+      const Fit& c = *fit;
+#pragma GCC unroll 9
+      for (int m = 0; m < D + P; ++m)
+        M.col(m).noalias() += du * c[m];
+    }
+    return M;
   }
 
-  // stressAt in 3D on padded columns: a column of F^T G_a, of G_a sigma_a and of F [sigma] is
-  // one 4-wide multiply-add per term (Eigen splits a 3-row column into a 2-wide and a scalar
-  // one); the scalar work is only sigma_a = w C0 : sym(A_a) from the entries of A.
-  PaddedMat<D> paddedStressAt(Index i, const Mat<D>& F, const SymMatrix& Gs) {
-    const PaddedMat<D, D> Ft = padded<D, D>(Mat<D>(F.transpose()));
-    const PaddedMat<D, P> Gp = padded<D, P>(Gs);
+  // P^q_I padded, keeping G_I and R_I, from F and paddedGradients' M (3D). A column of F^T G_a,
+  // of G_a sigma_a and of F [sigma] is one 4-wide multiply-add per term; the scalar work is only
+  // sigma_a = w C0 : sym(A_a) from the entries of A.
+  PaddedMat<D> paddedStressAt(Index i, const PaddedMat<D>& F, const FitSum& M) {
+    if (weight_[i] == 0.0) return PaddedMat<D>::Zero();  // R_i stays zero
+    const auto Gp = M.template rightCols<P>();           // Gs padded
+    const auto Gs = Gp.template topRows<D>();
+    G_[i] = Gs;
+    if (smallStrain_[i]) return smallStrainHyperstress(i, G_[i]);
     PaddedMat<D, P> A;  // column (a, b) = F^T G_a(:, b) = A_a(:, b)
-    A.noalias() = Ft.lazyProduct(Gs);
+    A.noalias() = transposed<D>(F).lazyProduct(Gs);
     const double lambda = weight_[i] * lambda_[i], mu = weight_[i] * mu_[i];
     Gradients sigma;  // sigma_a = lambda tr(A_a) 1 + mu (A_a + A_a^T)
 #pragma GCC unroll 3
@@ -256,8 +267,24 @@ class TaylorQuadrature {
 #pragma GCC unroll 3
         for (int b = 0; b < D; ++b)
           Pq.col(c).noalias() += Gp.col(sym(a, b)) * sigma[a](b, c);
-    R_[i].noalias() = padded<D, D>(F).lazyProduct(symmetric(sigma));  // R_a = F sigma_a
+    R_[i].noalias() = F.lazyProduct(symmetric(sigma));  // R_a = F sigma_a
     return Pq;
+  }
+
+ private:
+  // Column (a, b) of the symmetric storage (a, b in either order).
+  static constexpr int sym(int a, int b) {
+    return a <= b ? a * D - a * (a - 1) / 2 + (b - a) : sym(b, a);
+  }
+
+  // The linear-elastic material's hyperstress, e_a = sym(G_a): no P^q.
+  PaddedMat<D> smallStrainHyperstress(Index i, const SymMatrix& Gs) {
+    const Gradients G = unpack(Gs);
+    Gradients sigma;
+    for (int a = 0; a < D; ++a)
+      sigma[a] = weight_[i] * stressOf(i, G[a]);
+    R_[i].template topRows<D>() = symmetric(sigma);
+    return PaddedMat<D>::Zero();
   }
 
   // C0 : sym(A)
@@ -270,7 +297,7 @@ class TaylorQuadrature {
   // (a < b) or R_a(:, a).
   static SymMatrix symmetric(const Gradients& R) {
     SymMatrix Rs;
-    int t = 0;
+    int t = 0;  // sym(a, b), counted: the loops stay rolled and sym() would be computed
     for (int a = 0; a < D; ++a)
       for (int b = a; b < D; ++b, ++t)
         Rs.col(t) = a == b ? Vec<D>(R[a].col(a)) : Vec<D>(R[a].col(b) + R[b].col(a));

@@ -88,11 +88,8 @@ class TlsphForces {
       if (hourglass.form == HourglassForm::Energy) {
         energyHourglass_ = std::make_unique<EnergyHourglass<D>>(reference, std::move(c), volume);
         stress_.assign(n, PaddedMat<D>::Zero());
-        if constexpr (D == 3) {  // the penalty's gathered u and F, padded
-          paddedU_.assign(n, PaddedVec<D>::Zero());
+        if constexpr (D == 3)  // the penalty's gathered F, padded
           paddedPenaltyF_.assign(n, padded<D, D>(Mat<D>::Identity()));
-          copyPenaltyF_ = !separateHourglassGradient_;
-        }
         if (separateHourglassGradient_) linearReverseGradients(volume);
       } else {
         ganzenmueller_ = std::make_unique<GanzenmuellerHourglass<D>>(std::move(c));
@@ -104,6 +101,8 @@ class TlsphForces {
           reference, materials, materialOfParticle, smoothingLength, viscosity);
       viscousForce_.assign(n, Vec<D>::Zero());
     }
+    // 3D: u padded for the pair loops that gather it (the quadrature's F pass, the penalty)
+    if (D == 3 && (quadrature_ || energyHourglass_)) paddedU_.assign(n, PaddedVec<D>::Zero());
     prefetchGathers_ = gathersFromMemory(gatheredBytesPerParticle() * n);
   }
 
@@ -150,6 +149,7 @@ class TlsphForces {
   // halo's values.
   void compute(const std::vector<Vec<D>>& u, std::vector<Vec<D>>& f,
                const std::vector<Vec<D>>* v = nullptr) {
+    padDisplacements(u);
     quadrature_ ? stressPass<true>(u) : stressPass<false>(u);
     // The penalty reads the neighbours' F (the one it compares with; padded for the energy form).
     if (comm_ && hourglass_.enabled()) {
@@ -323,6 +323,10 @@ class TlsphForces {
            (energyHourglass_ ? sizeof(PaddedMat<D>) : 0);
   }
 
+  // 3D: the F pass writes the padded F the energy penalty gathers (unless the penalty has its
+  // own linear F, written by that F's pass).
+  bool penaltyReadsF() const { return energyHourglass_ && !separateHourglassGradient_; }
+
   // F_I = 1 + sum_J (u_J - u_I) (x) g_IJ (6.69), for the gradient vectors g given.
   Mat<D> deformationGradientOf(Index i, const std::vector<Vec<D>>& u,
                                const SharedRows<Vec<D>>& gradients) const {
@@ -365,28 +369,46 @@ class TlsphForces {
     for (Index p = 0; p < count; ++p) {
       const Index i = group[p];
       // deformationGradientOf written out: the hot loop measured 2-3 % slower through the call
-      Mat<D> gradU;
-      [[maybe_unused]] typename TaylorQuadrature<D>::SymMatrix Gs;
-      if constexpr (Taylor) {
-        q->gradients(i, u, gradU, Gs);  // grad u and grad grad u in one pass
+      Mat<D> F;
+      [[maybe_unused]] typename TaylorQuadrature<D>::SymMatrix Gs;  // 2D
+      [[maybe_unused]] typename TaylorQuadrature<D>::FitSum M;      // 3D: [grad u | Gs]
+      [[maybe_unused]] PaddedMat<D> Fp;                             // 3D: F padded
+      if constexpr (Taylor && D == 3) {
+        M = q->paddedGradients(i, paddedU_);  // grad u and grad grad u in one pass, padded
+        Fp = padded<D, D>(Mat<D>::Identity()) + M.template leftCols<D>();  // (6.69)
+        F = Fp.template topRows<D>();
       } else {
-        const Vec<D> ui = u[i];
-        gradU.setZero();
-        const Vec<D>* g = correctedGradient_.row(i);
-        for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k, ++g) {
-          prefetchAhead(g);
-          gradU.noalias() += (u[nb.neighbour[k]] - ui) * g->transpose();
+        Mat<D> gradU;
+        if constexpr (Taylor) {
+          q->gradients(i, u, gradU, Gs);  // grad u and grad grad u in one pass
+        } else {
+          const Vec<D> ui = u[i];
+          gradU.setZero();
+          const Vec<D>* g = correctedGradient_.row(i);
+          for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k, ++g) {
+            prefetchAhead(g);
+            gradU.noalias() += (u[nb.neighbour[k]] - ui) * g->transpose();
+          }
         }
+        F = Mat<D>::Identity() + gradU;  // (6.69)
       }
-      const Mat<D> F = Mat<D>::Identity() + gradU;  // (6.69)
       F_[i] = F;
       if constexpr (D == 3)
-        if (copyPenaltyF_) paddedPenaltyF_[i].template topRows<D>() = F;
+        if (penaltyReadsF()) {
+          if constexpr (Taylor)
+            paddedPenaltyF_[i] = Fp;
+          else
+            paddedPenaltyF_[i].template topRows<D>() = F;
+        }
       if constexpr (!std::is_void_v<Model>) {
         const Mat<D> P = firstPiolaKirchhoff<D>(*model, F);
         P_[i] = P;
         if constexpr (Taylor) {
-          PaddedMat<D> S = q->stressAt(i, F, Gs);  // P^q
+          PaddedMat<D> S;  // P^q
+          if constexpr (D == 3)
+            S = q->paddedStressAt(i, Fp, M);
+          else
+            S = q->stressAt(i, F, Gs);
           S.template topRows<D>() += P;
           quadratureStress_[i] = S;
         }
@@ -412,21 +434,26 @@ class TlsphForces {
       return separateHourglassGradient_ ? hourglassF_ : F_;
   }
 
+  // 3D: paddedU_ = u padded (the halo's as well), for the pair loops that gather it.
+  void padDisplacements(const std::vector<Vec<D>>& u) {
+    if constexpr (D == 3) {
+      const Index n = static_cast<Index>(paddedU_.size());
+#pragma omp parallel for schedule(static)
+      for (Index i = 0; i < n; ++i)
+        paddedU_[i].template head<D>() = u[i];
+    }
+  }
+
   // stress_ = P + P^hg (P^hg alone when P is null) and the springs (EnergyHourglass), reading
-  // u and F padded in 3D.
+  // u and F padded in 3D (paddedU_ written at the start of compute()).
   template <class PM>
   void hourglassStress(const std::vector<Vec<D>>& u, const PM* P) {
     const std::vector<Index>* owned = comm_ ? &owned_ : nullptr;
     std::span<const PaddedVec<D>> uh;
-    if constexpr (D == 3) {
-      const Index n = ref_.particleCount();  // the halo's as well
-#pragma omp parallel for schedule(static)
-      for (Index i = 0; i < n; ++i)
-        paddedU_[i].template head<D>() = u[i];
+    if constexpr (D == 3)
       uh = paddedU_;
-    } else {
+    else
       uh = u;
-    }
     std::span<const PaddedMat<D>> F = penaltyGradient();
     if (prefetchGathers_)
       energyHourglass_->template evaluate<false, true>(uh, F, P, std::span(stress_), owned);
@@ -557,7 +584,6 @@ class TlsphForces {
   // 3D, energy form: u and the penalty's F padded for its pass (Padded.hpp)
   LargeArray<PaddedVec<D>> paddedU_;
   LargeArray<PaddedMat<D>> paddedPenaltyF_;
-  bool copyPenaltyF_ = false;  // the F pass writes paddedPenaltyF_ (else the linear F's pass)
   SharedRows<Vec<D>> reverseGradient_;    // t_IJ
   SharedRows<Vec<D>> correctedGradient_;  // g_IJ (nodal quadrature, passive particles)
   SharedRows<Vec<D>> linearReverse_;      // t^lin_IJ (energy penalty on the linear F only)
