@@ -134,6 +134,8 @@ class TaylorQuadrature {
   void gatherAll(Communicator& comm) { comm.gatherAll(G_); }
 
   PaddedVec<D> hyperForceOwn(Index i) const { return R_[i] * sum_[i]; }
+  // Every particle's hyperstress R_I (symmetric storage, padded), as the force pass reads it.
+  const LargeArray<PaddedSymMatrix>& hyperstresses() const { return R_; }
   // Particle i's row of T_IJ (T[m] for its m-th pair), and one pair's term R_J . T_IJ.
   const Sym* reverseRow(Index i) const { return reverse_.row(i); }
   template <bool Gather = false>

@@ -24,6 +24,7 @@
 #include "tlsph/EnergyHourglass.hpp"
 #include "tlsph/GanzenmuellerHourglass.hpp"
 #include "tlsph/HourglassStiffness.hpp"
+#include "tlsph/InternalForceScatter.hpp"
 #include "tlsph/OrderedSum.hpp"
 #include "tlsph/Padded.hpp"
 #include "tlsph/PairTerms.hpp"
@@ -103,6 +104,15 @@ class TlsphForces {
     }
     // 3D: u padded for the pair loops that gather it (the quadrature's F pass, the penalty)
     if (D == 3 && (quadrature_ || energyHourglass_)) paddedU_.assign(n, PaddedVec<D>::Zero());
+    // The force pass summed from its sources when it has no other pair term
+    if (!ganzenmueller_ && !viscosity_ && !separateHourglassGradient_) {
+      if (quadrature_)
+        taylorScatter_ = std::make_unique<InternalForceScatter<D, true>>(
+            reference.neighbours, reverseGradient_, &quadrature_->reverseRows());
+      else
+        nodalScatter_ = std::make_unique<InternalForceScatter<D, false>>(reference.neighbours,
+                                                                         reverseGradient_, nullptr);
+    }
     prefetchGathers_ = gathersFromMemory(gatheredBytesPerParticle() * n);
   }
 
@@ -119,6 +129,10 @@ class TlsphForces {
       std::erase_if(group, [&](Index i) { return !mine[i]; });
     ownedPassive_ = passive_;
     std::erase_if(ownedPassive_, [&](Index i) { return !mine[i]; });
+    // the force pass's sources: the particles with a list (this rank's and its halo)
+    scatterSources_.clear();
+    for (Index j = 0; j < ref_.particleCount(); ++j)
+      if (ref_.neighbours.count(j) > 0) scatterSources_.push_back(j);
     // a rank gathers about its own particles' values (and its halo's)
     prefetchGathers_ = gathersFromMemory(gatheredBytesPerParticle() * double(owned.size()));
   }
@@ -281,10 +295,18 @@ class TlsphForces {
       t.perParticle += I + PV + PM + P + M + V + V + PM + d;
     }
     // Force pass: j, t_IJ (+ T_IJ) (+ t^lin_IJ); S_I, G_I (+ R_I, Sum_I), V_I; writes f.
+    // Summed from its sources: the records [t_IJ (+ T_IJ)] in the sources' rows, and each
+    // target's sum written (its own terms) and read back (the sources' terms hit the cache).
     pairIndices();
-    stream(reverseGradient_.storedBytes(), V);
-    if (taylor) stream(q->reverseRows().storedBytes(), S);
-    if (separateHourglassGradient_) stream(linearReverse_.storedBytes(), V);
+    if (scattersInternalForce()) {
+      stream(taylor ? taylorScatter_->storedPairBytes() : nodalScatter_->storedPairBytes(),
+             V + (taylor ? S : 0.0));
+      t.perParticle += 2 * PV;
+    } else {
+      stream(reverseGradient_.storedBytes(), V);
+      if (taylor) stream(q->reverseRows().storedBytes(), S);
+      if (separateHourglassGradient_) stream(linearReverse_.storedBytes(), V);
+    }
     const bool paddedS = (energyHourglass_ && !separateHourglassGradient_) || taylor;
     t.perParticle += I + (paddedS ? PM : M) + V + (taylor ? PSM + S : 0.0) + d + V;
     if (ganzenmueller_ || viscosity_) t.perParticle += V;     // u_I for x_IJ
@@ -312,15 +334,25 @@ class TlsphForces {
   bool prefetchGathers() const { return prefetchGathers_; }
   void prefetchGathers(bool on) { prefetchGathers_ = on; }
 
+  // Whether the force pass is summed from its sources (InternalForceScatter: when it has no
+  // pair term but the internal force) rather than gathered. The same bits either way; the
+  // setter (off) is for the tests.
+  bool scattersInternalForce() const { return scatter_ && (taylorScatter_ || nodalScatter_); }
+  void scatterInternalForce(bool on) { scatter_ = on; }
+
   // K_I = sum_J k_IJ per particle: the penalty's spring stiffness (empty when it is off).
   const std::vector<double>& hourglassStiffness() const { return hourglassStiffness_; }
 
  private:
-  // What the force pass (S_J, R_J) and the penalty (F_J) gather, in bytes per particle.
+  // What the force pass (S_J, R_J; summed from its sources, the sums it adds to) and the
+  // penalty (F_J) gather, in bytes per particle.
   double gatheredBytesPerParticle() const {
-    return sizeof(PaddedMat<D>) +
-           (quadrature_ ? sizeof(typename TaylorQuadrature<D>::PaddedSymMatrix) : 0) +
-           (energyHourglass_ ? sizeof(PaddedMat<D>) : 0);
+    const double force =
+        scattersInternalForce()
+            ? sizeof(PaddedVec<D>)
+            : sizeof(PaddedMat<D>) +
+                  (quadrature_ ? sizeof(typename TaylorQuadrature<D>::PaddedSymMatrix) : 0);
+    return force + (energyHourglass_ ? sizeof(PaddedMat<D>) : 0);
   }
 
   // 3D: the F pass writes the padded F the energy penalty gathers (unless the penalty has its
@@ -495,6 +527,13 @@ class TlsphForces {
   template <bool Taylor, bool Gather, class SM>
   void forcePass(const LargeArray<SM>& S, const std::vector<Vec<D>>& u, std::vector<Vec<D>>& f,
                  const std::vector<Vec<D>>* v, bool viscous) {
+    if (scattersInternalForce()) {
+      if constexpr (Taylor)
+        scatterForces(*taylorScatter_, S, f);
+      else
+        scatterForces(*nodalScatter_, S, f);
+      return;
+    }
     if (energyHourglass_ && separateHourglassGradient_)
       viscous ? accumulateForces<false, true, true, Taylor, Gather>(S, u, f, v)
               : accumulateForces<false, false, true, Taylor, Gather>(S, u, f, v);
@@ -567,6 +606,29 @@ class TlsphForces {
     }
   }
 
+  // f_I = V_I (S_I G_I (+ R_I . Sum_I) - sum_J ...) + the spring, the sum over J from the
+  // sources (InternalForceScatter); the own terms and the finish as accumulateForces has them.
+  template <bool Taylor, class SM>
+  void scatterForces(InternalForceScatter<D, Taylor>& scatter, const LargeArray<SM>& S,
+                     std::vector<Vec<D>>& f) {
+    constexpr int R = SM::RowsAtCompileTime;
+    [[maybe_unused]] const TaylorQuadrature<D>* q = quadrature_.get();
+    scatter.accumulate(
+        S, Taylor ? &q->hyperstresses() : nullptr, comm_ ? &owned_ : nullptr,
+        comm_ ? &scatterSources_ : nullptr,
+        [&](Index i) {
+          PaddedVec<D> own = PaddedVec<D>::Zero();
+          own.template head<R>().noalias() = S[i] * ref_.correctedGradientSum[i];
+          if constexpr (Taylor) own += q->hyperForceOwn(i);
+          return own;
+        },
+        [&](Index i, const PaddedVec<D>& sum) {
+          Vec<D> total = volume_[i] * sum.template head<D>();
+          if (energyHourglass_) total += energyHourglass_->springForce(i);
+          f[i] = total;
+        });
+  }
+
   const ReferenceConfiguration<D>& ref_;
   Communicator* comm_ = nullptr;  // distributed runs only
   std::vector<Index> owned_;      // distributed: this rank's particles, ascending
@@ -600,6 +662,11 @@ class TlsphForces {
   std::unique_ptr<ArtificialViscosity<D>> viscosity_;
   std::vector<Vec<D>> hourglassForce_;
   std::vector<Vec<D>> viscousForce_;
+  // the force pass summed from its sources (InternalForceScatter), with or without Taylor
+  std::unique_ptr<InternalForceScatter<D, true>> taylorScatter_;
+  std::unique_ptr<InternalForceScatter<D, false>> nodalScatter_;
+  std::vector<Index> scatterSources_;  // distributed: the particles with a list
+  bool scatter_ = true;
 };
 
 extern template class TlsphForces<2>;
