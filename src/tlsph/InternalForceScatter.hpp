@@ -18,6 +18,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <type_traits>
 #include <vector>
 
@@ -52,6 +53,11 @@ class InternalForceScatter {
       : nb_(nb), sums_(static_cast<std::size_t>(nb.particleCount()), PaddedVec<D>::Zero()) {
     PairArray<Record> records(nb.pairCount(), Record::Zero());
     const Index n = nb.particleCount();
+    // each source's first and last target (its sorted row's ends; an empty row matches none)
+    targetSpan_.assign(static_cast<std::size_t>(n), {n, -1});
+    for (Index j = 0; j < n; ++j)
+      if (nb.count(j) > 0)
+        targetSpan_[j] = {nb.neighbour[nb.offset[j]], nb.neighbour[nb.offset[j + 1] - 1]};
 #pragma omp parallel for schedule(static)
     for (Index j = 0; j < n; ++j)
       for (Index k = nb.offset[j]; k < nb.offset[j + 1]; ++k) {
@@ -114,15 +120,17 @@ class InternalForceScatter {
   void scatterFrom(Index j, Index a, Index b, const LargeArray<SM>& S,
                    const LargeArray<PaddedSymMatrix>* R) {
     constexpr int Rows = SM::RowsAtCompileTime;
+    // (the spans: one sequential read per source, where the rows' ends would be two lines)
+    if (targetSpan_[j][1] < a || targetSpan_[j][0] >= b) return;
     const Index* neighbour = nb_.neighbour.data();
     const Index start = nb_.offset[j];
     Index k0 = start, k1 = nb_.offset[j + 1];
-    if (k0 == k1 || neighbour[k1 - 1] < a || neighbour[k0] >= b) return;
     while (neighbour[k0] < a)
       ++k0;
     while (neighbour[k1 - 1] >= b)
       --k1;
-    const SM Sj = S[j];
+    SM Sj;
+    Sj = S[j];  // assigned, it stays in registers; copy-constructed, GCC staged it on the stack
     [[maybe_unused]] PaddedSymMatrix Rj;
     if constexpr (Taylor) Rj = (*R)[j];
     const Record* record = records_.row(j) + (k0 - start);
@@ -143,7 +151,8 @@ class InternalForceScatter {
 
   const NeighbourList& nb_;
   SharedRows<Record> records_;
-  LargeArray<PaddedVec<D>> sums_;  // per target
+  std::vector<std::array<Index, 2>> targetSpan_;  // per source: its first and last target
+  LargeArray<PaddedVec<D>> sums_;                 // per target
 };
 
 }  // namespace tlsph
