@@ -7,7 +7,9 @@
 // which for the linear correction is (6.70): V_I sum_J V_J (B_I + B_J) gradW_IJ, B = P L^{-T}.
 // Each auxiliary term is its own operator (EnergyHourglass, GanzenmuellerHourglass,
 // ArtificialViscosity); the force pass is instantiated for the terms the scene uses, so a
-// term that is off is not computed and the loops carry no branch on options.
+// term that is off is not computed and the loops carry no branch on options. When the internal
+// force is its only pair term, the force pass is summed from its sources
+// (InternalForceScatter: the same bits, each neighbour's stress loaded once per particle).
 #pragma once
 
 #include <algorithm>
