@@ -56,8 +56,11 @@ class InternalForceScatter {
     // each source's first and last target (its sorted row's ends; an empty row matches none)
     targetSpan_.assign(static_cast<std::size_t>(n), {n, -1});
     for (Index j = 0; j < n; ++j)
-      if (nb.count(j) > 0)
+      if (nb.count(j) > 0) {
         targetSpan_[j] = {nb.neighbour[nb.offset[j]], nb.neighbour[nb.offset[j + 1] - 1]};
+        sources_.push_back(j);
+      }
+    if (static_cast<Index>(sources_.size()) == n) sources_.clear();  // every particle
 #pragma omp parallel for schedule(static)
     for (Index j = 0; j < n; ++j)
       for (Index k = nb.offset[j]; k < nb.offset[j + 1]; ++k) {
@@ -83,16 +86,15 @@ class InternalForceScatter {
   }
 
   // For the targets (all particles, or the ascending list given): sum_i = own(i) minus the
-  // terms of every source J with i in its list (all particles with a list, or `sources`,
-  // ascending), then finish(i, sum_i). S: the stress sent through t_IJ (padded or plain);
-  // R: the hyperstresses (Taylor).
+  // terms of every source J (particle with a list) with i in its list, then finish(i, sum_i). S:
+  // the stress sent through t_IJ (padded or plain); R: the hyperstresses (Taylor).
   template <class SM, class Own, class Finish>
   void accumulate(const LargeArray<SM>& S, const LargeArray<PaddedSymMatrix>* R,
-                  const std::vector<Index>* targets, const std::vector<Index>* sources, Own&& own,
-                  Finish&& finish) {
+                  const std::vector<Index>* targets, Own&& own, Finish&& finish) {
     const Index n = nb_.particleCount();
     const Index count = targets ? static_cast<Index>(targets->size()) : n;
-    const Index sourceCount = sources ? static_cast<Index>(sources->size()) : n;
+    const bool listed = !sources_.empty();
+    const Index sourceCount = listed ? static_cast<Index>(sources_.size()) : n;
 #pragma omp parallel
     {
 #ifdef _OPENMP
@@ -107,7 +109,7 @@ class InternalForceScatter {
         for (Index p = p0; p < p1; ++p)
           sums_[target(p)] = own(target(p));
         for (Index s = 0; s < sourceCount; ++s)
-          scatterFrom(sources ? (*sources)[s] : s, a, b, S, R);
+          scatterFrom(listed ? sources_[s] : s, a, b, S, R);
         for (Index p = p0; p < p1; ++p)
           finish(target(p), sums_[target(p)]);
       }
@@ -152,7 +154,8 @@ class InternalForceScatter {
   const NeighbourList& nb_;
   SharedRows<Record> records_;
   std::vector<std::array<Index, 2>> targetSpan_;  // per source: its first and last target
-  LargeArray<PaddedVec<D>> sums_;                 // per target
+  std::vector<Index> sources_;     // the particles with a list, ascending; empty: all of them
+  LargeArray<PaddedVec<D>> sums_;  // per target
 };
 
 }  // namespace tlsph

@@ -85,8 +85,8 @@ class TaylorQuadrature {
 
   // The force pass's parts, fused into TlsphForces' loops (one pass over the pairs each):
   // in the F loop, grad u and Gs = grad grad u together (gradients), then stressAt(i, F_I, Gs)
-  // = P^q_I, added to the stress sent through g_IJ, which also keeps G_I and the hyperstress
-  // R_I; in the force loop, f_I += V_I (R_I . Sum_I - sum_J R_J . T_IJ) (hyperForce*).
+  // = P^q_I, added to the stress sent through g_IJ, which also keeps the hyperstress R_I (and
+  // in 2D G_I); in the force loop, f_I += V_I (R_I . Sum_I - sum_J R_J . T_IJ) (hyperForce*).
   //
   // [grad u | Gs] = sum_J (u_J - u_I) (x) [g_IJ, S_IJ] (6.69 and the fit's second
   // derivatives): row a accumulates du_a [g_IJ, S_IJ], one (D + P)-wide multiply-add per row
@@ -111,7 +111,7 @@ class TaylorQuadrature {
       Gs.row(a) = rows[a].template tail<P>();
     }
   }
-  // P^q_I, keeping G_I and the hyperstress R_I (2D; 3D: paddedStressAt).
+  // P^q_I, keeping G_I and the hyperstress R_I (2D; 3D: paddedStressAt, which keeps R_I).
   Mat<D> stressAt(Index i, const Mat<D>& F, const SymMatrix& Gs) requires(D == 2) {
     if (weight_[i] == 0.0) return Mat<D>::Zero();  // R_i stays zero
     G_[i] = Gs;
@@ -183,8 +183,16 @@ class TaylorQuadrature {
     return force_[i];
   }
   // grad grad u of every particle at the last force pass, in the symmetric storage (unpack()).
+  // In 3D the pass does not keep it: TlsphForces fills it (keepSecondGradients) before an
+  // observer reads it, through TlsphForces::quadrature().
   const std::vector<SymMatrix>& secondGradients() const {
     return G_;
+  }
+  // 3D: G_i from u as the F pass computed it (paddedGradients: the same sums, the same bits);
+  // zero where the pass computes no correction.
+  void keepSecondGradients(Index i, std::span<const PaddedVec<D>> u) requires(D == 3) {
+    if (weight_[i] != 0.0)
+      G_[i] = paddedGradients(i, u).template rightCols<P>().template topRows<D>();
   }
 
   // The stored per-pair rows (SharedRows.hpp): the fit [g_IJ, S_IJ] and T_IJ.
@@ -232,15 +240,14 @@ class TaylorQuadrature {
     return M;
   }
 
-  // P^q_I padded, keeping G_I and R_I, from F and paddedGradients' M (3D). A column of F^T G_a,
+  // P^q_I padded, keeping R_I, from F and paddedGradients' M (3D). A column of F^T G_a,
   // of G_a sigma_a and of F [sigma] is one 4-wide multiply-add per term; the scalar work is only
   // sigma_a = w C0 : sym(A_a) from the entries of A.
   PaddedMat<D> paddedStressAt(Index i, const PaddedMat<D>& F, const FitSum& M) {
     if (weight_[i] == 0.0) return PaddedMat<D>::Zero();  // R_i stays zero
     const auto Gp = M.template rightCols<P>();           // Gs padded
     const auto Gs = Gp.template topRows<D>();
-    G_[i] = Gs;
-    if (smallStrain_[i]) return smallStrainHyperstress(i, G_[i]);
+    if (smallStrain_[i]) return smallStrainHyperstress(i, Gs);
     PaddedMat<D, P> A;  // column (a, b) = F^T G_a(:, b) = A_a(:, b)
     A.noalias() = transposed<D>(F).lazyProduct(Gs);
     const double lambda = weight_[i] * lambda_[i], mu = weight_[i] * mu_[i];

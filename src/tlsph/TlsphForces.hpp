@@ -50,8 +50,7 @@ class TlsphForces {
         materials_(materials),
         volume_(volume),
         hourglass_(hourglass),
-        F_(reference.particleCount(), Mat<D>::Identity()),
-        P_(reference.particleCount(), Mat<D>::Zero()) {
+        F_(reference.particleCount(), Mat<D>::Identity()) {
     const Index n = reference.particleCount();
     // The pair loops stream only the distinct rows of the gradient vectors (SharedRows.hpp).
     reverseGradient_ = SharedRows<Vec<D>>(reference.neighbours, reference.reverseGradient);
@@ -73,7 +72,8 @@ class TlsphForces {
     if (quadrature == Quadrature::Taylor) {
       quadrature_ = std::make_unique<TaylorQuadrature<D>>(reference, materials, materialOfParticle,
                                                           volume, isPassive);
-      quadratureStress_.assign(n, PaddedMat<D>::Zero());
+    } else {
+      P_.assign(n, Mat<D>::Zero());  // (with Taylor, P is only a part of P + P^q)
     }
     if (hourglass.enabled()) {
       auto c = hourglassPairCoefficients(reference, materials, materialOfParticle, volume,
@@ -104,6 +104,8 @@ class TlsphForces {
           reference, materials, materialOfParticle, smoothingLength, viscosity);
       viscousForce_.assign(n, Vec<D>::Zero());
     }
+    // P + P^q: written straight into P + P^hg's array when the penalty adds P^hg in place
+    if (quadrature_ && !penaltyReadsF()) quadratureStress_.assign(n, PaddedMat<D>::Zero());
     // 3D: u padded for the pair loops that gather it (the quadrature's F pass, the penalty)
     if (D == 3 && (quadrature_ || energyHourglass_)) paddedU_.assign(n, PaddedVec<D>::Zero());
     // The force pass summed from its sources when it has no other pair term
@@ -131,20 +133,16 @@ class TlsphForces {
       std::erase_if(group, [&](Index i) { return !mine[i]; });
     ownedPassive_ = passive_;
     std::erase_if(ownedPassive_, [&](Index i) { return !mine[i]; });
-    // the force pass's sources: the particles with a list (this rank's and its halo)
-    scatterSources_.clear();
-    for (Index j = 0; j < ref_.particleCount(); ++j)
-      if (ref_.neighbours.count(j) > 0) scatterSources_.push_back(j);
     // a rank gathers about its own particles' values (and its halo's)
     prefetchGathers_ = gathersFromMemory(gatheredBytesPerParticle() * double(owned.size()));
   }
 
-  // Every rank's entries of what observers read (F, P, the hourglass and viscous forces, the
+  // Every rank's entries of what observers read (F, the hourglass and viscous forces, the
   // quadrature's second gradients) onto every rank; nothing in a serial run.
   void gatherAll() {
     if (!comm_) return;
+    observe();
     comm_->gatherAll(F_);
-    comm_->gatherAll(P_);
     comm_->gatherAll(hourglassF_);
     comm_->gatherAll(hourglassForce_);
     comm_->gatherAll(viscousForce_);
@@ -165,6 +163,7 @@ class TlsphForces {
   // halo's values.
   void compute(const std::vector<Vec<D>>& u, std::vector<Vec<D>>& f,
                const std::vector<Vec<D>>* v = nullptr) {
+    observed_ = false;
     padDisplacements(u);
     quadrature_ ? stressPass<true>(u) : stressPass<false>(u);
     // The penalty reads the neighbours' F (the one it compares with; padded for the energy form).
@@ -180,7 +179,7 @@ class TlsphForces {
       if (separateHourglassGradient_)
         hourglassStress(u, static_cast<const Mat<D>*>(nullptr));
       else if (quadrature_)
-        hourglassStress(u, quadratureStress_.data());
+        hourglassStress(u, stress_.data());  // P + P^q written there: P^hg added in place
       else
         hourglassStress(u, P_.data());
     }
@@ -201,19 +200,21 @@ class TlsphForces {
       forcePass<false>(u, f, v, viscous);
   }
 
-  const LargeArray<Mat<D>>& deformationGradient() const { return F_; }
+  // F of every particle at the last compute().
+  const LargeArray<Mat<D>>& deformationGradient() const {
+    observe();
+    return F_;
+  }
   // The textbook hourglass part of the last computed force (empty for the energy form and
   // when the term is off); the solver integrates its work.
   const std::vector<Vec<D>>& hourglassForce() const { return hourglassForce_; }
   // The artificial-viscosity part of the last computed force (empty when off).
   const std::vector<Vec<D>>& viscousForce() const { return viscousForce_; }
 
-  // First Piola-Kirchhoff stress of particle i at the last computed F (material only).
-  Mat<D> firstPiola(Index i) const { return P_[i]; }
-
   // E = sum_I V_I psi(F_I) at the last computed F: the discrete strain energy whose negative
   // gradient is the internal force.
   double strainEnergy() const {
+    observe();
     double total = 0.0;
     for (std::size_t m = 0; m < materials_.size(); ++m) {
       const auto& group = particlesOfMaterial_[m];
@@ -229,12 +230,17 @@ class TlsphForces {
     return total;
   }
 
-  // The quadrature correction (null unless [kernel] quadrature = taylor).
-  const TaylorQuadrature<D>* quadrature() const { return quadrature_.get(); }
+  // The quadrature correction (null unless [kernel] quadrature = taylor), its second
+  // gradients those of the last compute().
+  const TaylorQuadrature<D>* quadrature() const {
+    observe();
+    return quadrature_.get();
+  }
 
   // E_hg of the energy form for the displacements u of the last compute() (0 otherwise);
   // distributed: a collective, after gatherAll().
   double hourglassEnergy(const std::vector<Vec<D>>& u) const {
+    observe();
     return energyHourglass_
                ? energyHourglass_->energy(u, separateHourglassGradient_ ? hourglassF_ : F_,
                                           comm_ ? &owned_ : nullptr, comm_)
@@ -274,14 +280,16 @@ class TlsphForces {
       t.perPair += I;
       t.unsharedPerPair += I;
     };
-    // F pass: j and g_IJ (+ S_IJ); offset, group entry, u_I; writes F, P (+ P + P^q, the
-    // second gradients and the hyperstress, reading the particle's three constants).
+    // F pass: j and g_IJ (+ S_IJ); offset, group entry, u_I; writes F (unless only the padded
+    // copy below), P (nodal) or P + P^q, the hyperstress and in 2D the second gradients (Taylor,
+    // reading the particle's three constants).
     pairIndices();
     if (taylor)
       stream(q->fitRows().storedBytes(), V + S);
     else
       stream(correctedGradient_.storedBytes(), V);
-    t.perParticle += 2 * I + V + 2 * M + (taylor ? PM + SM + PSM + 3 * d : 0.0);
+    t.perParticle += 2 * I + V + (storesF() ? M : 0.0);
+    t.perParticle += taylor ? PM + (D == 2 ? SM : 0.0) + PSM + 3 * d : M;
     t.perParticle += paddedCopies * PM;  // the padded F the penalty gathers
     if (separateHourglassGradient_) {    // the penalty's own F through g^lin_IJ
       pairIndices();
@@ -360,6 +368,33 @@ class TlsphForces {
   // 3D: the F pass writes the padded F the energy penalty gathers (unless the penalty has its
   // own linear F, written by that F's pass).
   bool penaltyReadsF() const { return energyHourglass_ && !separateHourglassGradient_; }
+  // Whether the F pass writes F_ itself; in 3D with the penalty on F, F lives in the padded
+  // copy the penalty gathers and observe() copies it out.
+  bool storesF() const { return !(D == 3 && penaltyReadsF()); }
+
+  // Fills, once per compute() and when an observer first asks, what observers read but the
+  // step does not keep (issue 12: fewer bytes written per particle-step): F_ from the penalty's
+  // padded F (!storesF()) and, in 3D, the quadrature's grad grad u (recomputed from the padded
+  // u with the F pass's own sums). The step's values bit for bit. From serial code only.
+  void observe() const {
+    if (observed_) return;
+    observed_ = true;
+    if constexpr (D == 3) {
+      if (!storesF()) {
+        const Index n = ref_.particleCount();
+#pragma omp parallel for schedule(static)
+        for (Index i = 0; i < n; ++i)
+          F_[i] = paddedPenaltyF_[i].template topRows<D>();
+      }
+      if (quadrature_)
+        for (const auto& group : comm_ ? ownedOfMaterial_ : particlesOfMaterial_) {
+          const Index count = static_cast<Index>(group.size());
+#pragma omp parallel for schedule(static)
+          for (Index p = 0; p < count; ++p)
+            quadrature_->keepSecondGradients(group[p], paddedU_);
+        }
+    }
+  }
 
   // F_I = 1 + sum_J (u_J - u_I) (x) g_IJ (6.69), for the gradient vectors g given.
   Mat<D> deformationGradientOf(Index i, const std::vector<Vec<D>>& u,
@@ -383,22 +418,40 @@ class TlsphForces {
     for (std::size_t m = 0; m < materials_.size(); ++m)
       std::visit(
           [&](const auto& model) {
-            deformationAndStress<std::decay_t<decltype(model)>, Taylor>(&model, groups[m], u);
+            using Model = std::decay_t<decltype(model)>;
+            if (D == 3 && !storesF())
+              deformationAndStress<Model, Taylor, D == 3>(&model, groups[m], u);
+            else
+              deformationAndStress<Model, Taylor, false>(&model, groups[m], u);
           },
           materials_[m]);
     // Passive particles (mirrored ghosts): F for the penalty and the output, P stays zero.
     const auto& passive = comm_ ? ownedPassive_ : passive_;
-    if (!passive.empty()) deformationAndStress<void, false>(nullptr, passive, u);
+    if (!passive.empty()) {
+      if (D == 3 && !storesF())
+        deformationAndStress<void, false, D == 3>(nullptr, passive, u);
+      else
+        deformationAndStress<void, false, false>(nullptr, passive, u);
+      // their P + P^q is zero; where that is written into P + P^hg's array, clear the P^hg the
+      // penalty added there last step
+      if (quadrature_ && penaltyReadsF())
+        for (Index i : passive)
+          stress_[i].setZero();
+    }
   }
 
   // F (and the penalty's own linear F where it has one) of the particles in group; their
   // stress P unless Model is void (the passive particles); with Taylor, P + P^q as well.
-  template <class Model, bool Taylor>
+  // PaddedF: F summed padded and written only into the penalty's padded copy (!storesF(); a
+  // template argument: a branch on it in the loop made GCC spill around the log call).
+  template <class Model, bool Taylor, bool PaddedF>
   void deformationAndStress(const Model* model, const std::vector<Index>& group,
                             const std::vector<Vec<D>>& u) {
     const auto& nb = ref_.neighbours;
     const Index count = static_cast<Index>(group.size());
     [[maybe_unused]] TaylorQuadrature<D>* q = quadrature_.get();
+    // P + P^q where the penalty adds P^hg in place, else its own array
+    [[maybe_unused]] auto& taylorStress = penaltyReadsF() ? stress_ : quadratureStress_;
 #pragma omp parallel for schedule(static)
     for (Index p = 0; p < count; ++p) {
       const Index i = group[p];
@@ -410,6 +463,20 @@ class TlsphForces {
       if constexpr (Taylor && D == 3) {
         M = q->paddedGradients(i, paddedU_);  // grad u and grad grad u in one pass, padded
         Fp = padded<D, D>(Mat<D>::Identity()) + M.template leftCols<D>();  // (6.69)
+        F = Fp.template topRows<D>();
+      } else if constexpr (PaddedF && !Taylor) {
+        // 3D nodal with the penalty on F: the sums padded like the fit's above (u_J one 256-bit
+        // load, a column one 4-wide multiply-add), the same products in the same order
+        const PaddedVec<D> ui = paddedU_[i];
+        PaddedMat<D> gradU = PaddedMat<D>::Zero();
+        const Vec<D>* g = correctedGradient_.row(i);
+        for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k, ++g) {
+          prefetchAhead(g);
+          const PaddedVec<D> du = paddedU_[nb.neighbour[k]] - ui;
+          for (int m = 0; m < D; ++m)
+            gradU.col(m).noalias() += du * (*g)[m];
+        }
+        Fp = padded<D, D>(Mat<D>::Identity()) + gradU;  // (6.69)
         F = Fp.template topRows<D>();
       } else {
         Mat<D> gradU;
@@ -426,17 +493,13 @@ class TlsphForces {
         }
         F = Mat<D>::Identity() + gradU;  // (6.69)
       }
-      F_[i] = F;
-      if constexpr (D == 3)
-        if (penaltyReadsF()) {
-          if constexpr (Taylor)
-            paddedPenaltyF_[i] = Fp;
-          else
-            paddedPenaltyF_[i].template topRows<D>() = F;
-        }
+      if constexpr (PaddedF)
+        paddedPenaltyF_[i] = Fp;
+      else
+        F_[i] = F;
       if constexpr (!std::is_void_v<Model>) {
         const Mat<D> P = firstPiolaKirchhoff<D>(*model, F);
-        P_[i] = P;
+        if constexpr (!Taylor) P_[i] = P;
         if constexpr (Taylor) {
           PaddedMat<D> S;  // P^q
           if constexpr (D == 3)
@@ -444,7 +507,7 @@ class TlsphForces {
           else
             S = q->stressAt(i, F, Gs);
           S.template topRows<D>() += P;
-          quadratureStress_[i] = S;
+          taylorStress[i] = S;
         }
       }
     }
@@ -617,7 +680,6 @@ class TlsphForces {
     [[maybe_unused]] const TaylorQuadrature<D>* q = quadrature_.get();
     scatter.accumulate(
         S, Taylor ? &q->hyperstresses() : nullptr, comm_ ? &owned_ : nullptr,
-        comm_ ? &scatterSources_ : nullptr,
         [&](Index i) {
           PaddedVec<D> own = PaddedVec<D>::Zero();
           own.template head<R>().noalias() = S[i] * ref_.correctedGradientSum[i];
@@ -642,8 +704,8 @@ class TlsphForces {
   std::vector<std::vector<Index>> particlesOfMaterial_;  // without the passive particles
   std::vector<Index> passive_;
   // Per particle, gathered by the pair loops at the neighbours' indices: huge pages as well.
-  LargeArray<Mat<D>> F_;
-  LargeArray<Mat<D>> P_;
+  mutable LargeArray<Mat<D>> F_;     // (filled by observe() when !storesF())
+  LargeArray<Mat<D>> P_;             // nodal quadrature only (Taylor: P + P^q)
   LargeArray<PaddedMat<D>> stress_;  // P + P^hg (energy form only; P^hg alone on the linear F)
   // 3D, energy form: u and the penalty's F padded for its pass (Padded.hpp)
   LargeArray<PaddedVec<D>> paddedU_;
@@ -667,8 +729,8 @@ class TlsphForces {
   // the force pass summed from its sources (InternalForceScatter), with or without Taylor
   std::unique_ptr<InternalForceScatter<D, true>> taylorScatter_;
   std::unique_ptr<InternalForceScatter<D, false>> nodalScatter_;
-  std::vector<Index> scatterSources_;  // distributed: the particles with a list
   bool scatter_ = true;
+  mutable bool observed_ = true;  // observe() has run since the last compute()
 };
 
 extern template class TlsphForces<2>;
