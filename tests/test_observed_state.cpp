@@ -23,12 +23,17 @@ struct Case {
 };
 
 template <int D>
-std::unique_ptr<ForceEvaluator<D>> evaluatorFor(const Case& c, const std::vector<Vec<D>>& X) {
+Scene<D> sceneFor(const Case& c, const std::vector<Vec<D>>& X) {
   Scene<D> scene = sceneOf<D>(X, kDx, 2.4, testMaterial("neo-hookean"), c.alpha);
   scene.gradientCorrection = GradientCorrection::Quadratic;
   scene.quadrature = c.quadrature;
   scene.hourglassGradient = c.penaltyGradient;
-  return std::make_unique<ForceEvaluator<D>>(std::move(scene));
+  return scene;
+}
+
+template <int D>
+std::unique_ptr<ForceEvaluator<D>> evaluatorFor(const Case& c, const std::vector<Vec<D>>& X) {
+  return std::make_unique<ForceEvaluator<D>>(sceneFor<D>(c, X));
 }
 
 // A smooth non-affine displacement (grad grad u != 0) of size `size`.
@@ -42,18 +47,35 @@ std::vector<Vec<D>> displacement(const std::vector<Vec<D>>& X, double size, std:
   return u;
 }
 
+// A jittered block and two displacements of it.
 template <int D>
-void expectObserversReadTheLastCompute(const Case& c, std::uint32_t seed) {
+struct Block {
+  std::vector<Vec<D>> X, u1, u2;
+};
+template <int D>
+Block<D> blockFor(std::uint32_t seed) {
   std::mt19937 rng(seed);
   std::array<int, D> counts;
   counts.fill(D == 2 ? 6 : 4);
   counts[0] = D == 2 ? 8 : 5;
-  const auto X = perturbedBlock<D>(counts, kDx, 0.15, rng);
-  const auto u1 = displacement<D>(X, 1e-3, rng);
-  const auto u2 = displacement<D>(X, 2e-3, rng);
-  SCOPED_TRACE("D=" + std::to_string(D) + " alpha " + std::to_string(c.alpha) +
-               (c.quadrature == Quadrature::Taylor ? " taylor" : " nodal") +
-               (c.penaltyGradient == HourglassGradient::Linear ? " penalty on the linear F" : ""));
+  Block<D> b;
+  b.X = perturbedBlock<D>(counts, kDx, 0.15, rng);
+  b.u1 = displacement<D>(b.X, 1e-3, rng);
+  b.u2 = displacement<D>(b.X, 2e-3, rng);
+  return b;
+}
+
+template <int D>
+std::string traceOf(const Case& c) {
+  return "D=" + std::to_string(D) + " alpha " + std::to_string(c.alpha) +
+         (c.quadrature == Quadrature::Taylor ? " taylor" : " nodal") +
+         (c.penaltyGradient == HourglassGradient::Linear ? " penalty on the linear F" : "");
+}
+
+template <int D>
+void expectObserversReadTheLastCompute(const Case& c, std::uint32_t seed) {
+  const auto [X, u1, u2] = blockFor<D>(seed);
+  SCOPED_TRACE(traceOf<D>(c));
 
   // read after the first compute, then computed again
   auto read = evaluatorFor<D>(c, X);
@@ -114,17 +136,8 @@ void expectObserversReadTheLastCompute(const Case& c, std::uint32_t seed) {
 // F, P + P^q is written into the array the penalty adds P^hg to).
 template <int D>
 void expectNoStressCarriedOver(const Case& c, std::uint32_t seed) {
-  std::mt19937 rng(seed);
-  std::array<int, D> counts;
-  counts.fill(D == 2 ? 6 : 4);
-  counts[0] = D == 2 ? 8 : 5;
-  const auto X = perturbedBlock<D>(counts, kDx, 0.15, rng);
-  const auto u1 = displacement<D>(X, 1e-3, rng);
-  const auto u2 = displacement<D>(X, 2e-3, rng);
-  Scene<D> scene = sceneOf<D>(X, kDx, 2.4, testMaterial("neo-hookean"), c.alpha);
-  scene.gradientCorrection = GradientCorrection::Quadratic;
-  scene.quadrature = c.quadrature;
-  scene.hourglassGradient = c.penaltyGradient;
+  const auto [X, u1, u2] = blockFor<D>(seed);
+  const Scene<D> scene = sceneFor<D>(c, X);
   const auto& p = scene.particles;
   const auto ref = buildReferenceConfiguration<D>(p.referencePosition, p.volume,
                                                   Kernel<D>(scene.kernel, scene.supportRadius),
@@ -138,9 +151,7 @@ void expectNoStressCarriedOver(const Case& c, std::uint32_t seed) {
                                             scene.hourglass(), scene.quadrature,
                                             ViscositySettings{}, 0.0, passive);
   };
-  SCOPED_TRACE("D=" + std::to_string(D) + " alpha " + std::to_string(c.alpha) +
-               (c.quadrature == Quadrature::Taylor ? " taylor" : " nodal") +
-               (c.penaltyGradient == HourglassGradient::Linear ? " penalty on the linear F" : ""));
+  SCOPED_TRACE(traceOf<D>(c));
   std::vector<Vec<D>> f(p.size()), fresh(p.size());
   auto twice = forces();
   twice->compute(u1, f);
