@@ -5,6 +5,8 @@
 // on either F, quadrature correction) is linear in u, so f(u) = -K u up to rounding.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <random>
 #include <type_traits>
 
 #include "TestSupport.hpp"
@@ -43,6 +45,33 @@ TEST(Padded, TransposedIsTheTransposeWithAZeroFourthRow) {
   Mat<2> m2;
   m2 << 1, 2, 3, 4;
   EXPECT_EQ(transposed<2>(m2), Mat<2>(m2.transpose()));
+}
+
+// addTop() builds m's columns in registers (3D, AVX): each entry of s's top rows must be the
+// sum Eigen's topRows() += gives, bit for bit, and the fourth row stay zero.
+TEST(Padded, AddTopIsTheTopRowsSumWithAZeroFourthRow) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> value(-1.0, 1.0);
+  for (int trial = 0; trial < 20; ++trial) {
+    Mat<3> a, m;
+    for (int k = 0; k < 9; ++k) {
+      a(k) = value(rng) * std::pow(10.0, trial % 7 - 3);
+      m(k) = value(rng);
+    }
+    PaddedMat<3> s = padded<3, 3>(a);
+    addTop<3>(s, m);
+    PaddedMat<3> expected = padded<3, 3>(a);
+    expected.topRows<3>() += m;
+    for (int k = 0; k < 12; ++k)
+      EXPECT_EQ(s(k), expected(k)) << "entry " << k;  // bitwise: same operands, one addition
+    EXPECT_EQ(s.row(3).squaredNorm(), 0.0);
+  }
+  Mat<2> s2, m2;
+  s2 << 1, 2, 3, 4;
+  m2 << 0.5, 0.25, 0.125, 1.0 / 3.0;
+  const Mat<2> expected2 = s2 + m2;
+  addTop<2>(s2, m2);
+  EXPECT_EQ(s2, expected2);
 }
 
 struct Case {

@@ -506,7 +506,7 @@ class TlsphForces {
             S = q->paddedStressAt(i, Fp, M);
           else
             S = q->stressAt(i, F, Gs);
-          S.template topRows<D>() += P;
+          addTop<D>(S, P);
           taylorStress[i] = S;
         }
       }
