@@ -47,8 +47,8 @@ TEST(Padded, TransposedIsTheTransposeWithAZeroFourthRow) {
   EXPECT_EQ(transposed<2>(m2), Mat<2>(m2.transpose()));
 }
 
-// addTop() builds m's columns in registers (3D, AVX): each entry of s's top rows must be the
-// sum Eigen's topRows() += gives, bit for bit, and the fourth row stay zero.
+// addTop() builds m's columns in registers (3D, AVX): each entry of the result's top rows must
+// be the sum Eigen's topRows() += gives, bit for bit, the fourth row s's, and s unchanged.
 TEST(Padded, AddTopIsTheTopRowsSumWithAZeroFourthRow) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> value(-1.0, 1.0);
@@ -58,20 +58,22 @@ TEST(Padded, AddTopIsTheTopRowsSumWithAZeroFourthRow) {
       a(k) = value(rng) * std::pow(10.0, trial % 7 - 3);
       m(k) = value(rng);
     }
-    PaddedMat<3> s = padded<3, 3>(a);
-    addTop<3>(s, m);
-    PaddedMat<3> expected = padded<3, 3>(a);
+    const PaddedMat<3> s = padded<3, 3>(a);
+    PaddedMat<3> sum = PaddedMat<3>::Constant(-1.0);
+    addTop<3>(s, m, sum);
+    PaddedMat<3> expected = s;
     expected.topRows<3>() += m;
     for (int k = 0; k < 12; ++k)
-      EXPECT_EQ(s(k), expected(k)) << "entry " << k;  // bitwise: same operands, one addition
-    EXPECT_EQ(s.row(3).squaredNorm(), 0.0);
+      EXPECT_EQ(sum(k), expected(k)) << "entry " << k;  // bitwise: same operands, one addition
+    EXPECT_EQ(sum.row(3).squaredNorm(), 0.0);
+    const PaddedMat<3> unchanged = padded<3, 3>(a);
+    EXPECT_TRUE(s == unchanged);  // s itself
   }
-  Mat<2> s2, m2;
+  Mat<2> s2, m2, sum2;
   s2 << 1, 2, 3, 4;
   m2 << 0.5, 0.25, 0.125, 1.0 / 3.0;
-  const Mat<2> expected2 = s2 + m2;
-  addTop<2>(s2, m2);
-  EXPECT_EQ(s2, expected2);
+  addTop<2>(s2, m2, sum2);
+  EXPECT_TRUE(sum2 == Mat<2>(s2 + m2));
 }
 
 struct Case {

@@ -60,23 +60,24 @@ PaddedMat<D, D> transposed(const PaddedMat<D, D>& m) {
   return t;
 }
 
-// s.topRows<D>() += m, column by column. In 3D with AVX each column of m is put together in a
-// register (its entries wherever GCC holds them) and added as one 256-bit word: written as
-// Eigen's topRows() +=, GCC stored the sums in 16- and 8-byte pieces on the stack and reloaded
-// them as 256-bit words for the array store, stalling store-to-load forwarding (the Taylor F
-// pass, issue 12). The same sums, the same bits.
+// out = s with m added to its top D rows, column by column. In 3D with AVX each column of m is
+// put together in a register (its entries wherever GCC holds them), added to s's as one 256-bit
+// word and stored as one: written with Eigen, GCC moved such sums through the stack in 16- and
+// 8-byte pieces and reloaded them as 256-bit words, stalling store-to-load forwarding (the
+// Taylor F pass, issue 12). The same sums, the same bits.
 template <int D>
-void addTop(PaddedMat<D, D>& s, const Mat<D>& m) {
+void addTop(const PaddedMat<D, D>& s, const Mat<D>& m, PaddedMat<D, D>& out) {
 #ifdef __AVX__
   if constexpr (D == 3) {
     for (int c = 0; c < D; ++c) {
       const __m256d column = _mm256_set_pd(0.0, m(2, c), m(1, c), m(0, c));
-      _mm256_storeu_pd(s.col(c).data(), _mm256_add_pd(_mm256_loadu_pd(s.col(c).data()), column));
+      _mm256_storeu_pd(out.col(c).data(), _mm256_add_pd(_mm256_loadu_pd(s.col(c).data()), column));
     }
     return;
   }
 #endif
-  s.template topRows<D>() += m;
+  out = s;
+  out.template topRows<D>() += m;
 }
 
 }  // namespace tlsph

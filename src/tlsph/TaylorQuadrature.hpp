@@ -191,8 +191,11 @@ class TaylorQuadrature {
   // 3D: G_i from u as the F pass computed it (paddedGradients: the same sums, the same bits);
   // zero where the pass computes no correction.
   void keepSecondGradients(Index i, std::span<const PaddedVec<D>> u) requires(D == 3) {
-    if (weight_[i] != 0.0)
-      G_[i] = paddedGradients(i, u).template rightCols<P>().template topRows<D>();
+    if (weight_[i] != 0.0) {
+      FitSum M;
+      paddedGradients(i, u, M);
+      G_[i] = M.template rightCols<P>().template topRows<D>();
+    }
   }
 
   // The stored per-pair rows (SharedRows.hpp): the fit [g_IJ, S_IJ] and T_IJ.
@@ -224,7 +227,9 @@ class TaylorQuadrature {
   // and pair with u gathered as one 256-bit word (the rows above split into 2-wide and scalar
   // ones, issue 12); F, grad grad u and P^q come out padded for paddedStressAt.
   using FitSum = PaddedMat<D, D + P>;
-  FitSum paddedGradients(Index i, std::span<const PaddedVec<D>> u) const {
+  // Written into out from a local (returned by value, the 288-byte result was zeroed with a
+  // memset call and copied with a memcpy call per particle).
+  void paddedGradients(Index i, std::span<const PaddedVec<D>> u, FitSum& out) const {
     const auto& nb = ref_.neighbours;
     FitSum M = FitSum::Zero();  // a local: GCC keeps it in registers through the loop
     const PaddedVec<D> ui = u[i];
@@ -237,17 +242,29 @@ class TaylorQuadrature {
       for (int m = 0; m < D + P; ++m)
         M.col(m).noalias() += du * c[m];
     }
-    return M;
+    out = M;
   }
 
-  // P^q_I padded, keeping R_I, from F and paddedGradients' M (3D). A column of F^T G_a,
-  // of G_a sigma_a and of F [sigma] is one 4-wide multiply-add per term; the scalar work is only
-  // sigma_a = w C0 : sym(A_a) from the entries of A.
-  PaddedMat<D> paddedStressAt(Index i, const PaddedMat<D>& F, const FitSum& M) {
-    if (weight_[i] == 0.0) return PaddedMat<D>::Zero();  // R_i stays zero
-    const auto Gp = M.template rightCols<P>();           // Gs padded
+  // stress = Pm + P^q_I padded (Pm the material's P), keeping R_I, from F and paddedGradients'
+  // M (3D). A column of F^T G_a, of G_a sigma_a and of F [sigma] is one 4-wide multiply-add per
+  // term; the scalar work is only sigma_a = w C0 : sym(A_a) from the entries of A. Pm is added
+  // here, each column in a register, and the sum stored straight into the caller's array:
+  // returned by value, GCC wrote P^q in 16-byte halves that the caller reloaded as 256-bit
+  // words (a store-to-load forwarding stall per column, issue 12).
+  void paddedStressAt(Index i, const PaddedMat<D>& F, const FitSum& M, const Mat<D>& Pm,
+                      PaddedMat<D>& stress) {
+    PaddedMat<D> Pq = PaddedMat<D>::Zero();  // a local, in registers; P^q stays zero when
+    if (weight_[i] == 0.0) {                 // there is no correction (R_i stays zero)
+      addTop<D>(Pq, Pm, stress);
+      return;
+    }
+    const auto Gp = M.template rightCols<P>();  // Gs padded
     const auto Gs = Gp.template topRows<D>();
-    if (smallStrain_[i]) return smallStrainHyperstress(i, Gs);
+    if (smallStrain_[i]) {
+      smallStrainHyperstress(i, Gs);
+      addTop<D>(Pq, Pm, stress);
+      return;
+    }
     PaddedMat<D, P> A;  // column (a, b) = F^T G_a(:, b) = A_a(:, b)
     A.noalias() = transposed<D>(F).lazyProduct(Gs);
     const double lambda = weight_[i] * lambda_[i], mu = weight_[i] * mu_[i];
@@ -268,7 +285,7 @@ class TaylorQuadrature {
           sigma[a](c, b) = s;
         }
     }
-    PaddedMat<D> Pq = PaddedMat<D>::Zero();  // sum_a G_a sigma_a, column c
+    // P^q = sum_a G_a sigma_a, column c
 #pragma GCC unroll 3
     for (int c = 0; c < D; ++c)
 #pragma GCC unroll 3
@@ -277,7 +294,7 @@ class TaylorQuadrature {
         for (int b = 0; b < D; ++b)
           Pq.col(c).noalias() += Gp.col(sym(a, b)) * sigma[a](b, c);
     R_[i].noalias() = F.lazyProduct(symmetric(sigma));  // R_a = F sigma_a
-    return Pq;
+    addTop<D>(Pq, Pm, stress);
   }
 
  private:

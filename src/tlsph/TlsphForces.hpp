@@ -461,7 +461,7 @@ class TlsphForces {
       [[maybe_unused]] typename TaylorQuadrature<D>::FitSum M;      // 3D: [grad u | Gs]
       [[maybe_unused]] PaddedMat<D> Fp;                             // 3D: F padded
       if constexpr (Taylor && D == 3) {
-        M = q->paddedGradients(i, paddedU_);  // grad u and grad grad u in one pass, padded
+        q->paddedGradients(i, paddedU_, M);  // grad u and grad grad u in one pass, padded
         Fp = padded<D, D>(Mat<D>::Identity()) + M.template leftCols<D>();  // (6.69)
         F = Fp.template topRows<D>();
       } else if constexpr (PaddedF && !Taylor) {
@@ -501,13 +501,13 @@ class TlsphForces {
         const Mat<D> P = firstPiolaKirchhoff<D>(*model, F);
         if constexpr (!Taylor) P_[i] = P;
         if constexpr (Taylor) {
-          PaddedMat<D> S;  // P^q
-          if constexpr (D == 3)
-            S = q->paddedStressAt(i, Fp, M);
-          else
-            S = q->stressAt(i, F, Gs);
-          addTop<D>(S, P);
-          taylorStress[i] = S;
+          if constexpr (D == 3) {
+            q->paddedStressAt(i, Fp, M, P, taylorStress[i]);
+          } else {
+            PaddedMat<D> S = q->stressAt(i, F, Gs);  // P^q
+            S.template topRows<D>() += P;
+            taylorStress[i] = S;
+          }
         }
       }
     }
