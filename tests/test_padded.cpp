@@ -48,7 +48,7 @@ TEST(Padded, TransposedIsTheTransposeWithAZeroFourthRow) {
 }
 
 // addTop() builds m's columns in registers (3D, AVX): each entry of the result's top rows must
-// be the sum Eigen's topRows() += gives, bit for bit, the fourth row s's, and s unchanged.
+// be the sum Eigen's topRows() += gives, bit for bit, and the fourth row stay zero.
 TEST(Padded, AddTopIsTheTopRowsSumWithAZeroFourthRow) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> value(-1.0, 1.0);
@@ -66,8 +66,6 @@ TEST(Padded, AddTopIsTheTopRowsSumWithAZeroFourthRow) {
     for (int k = 0; k < 12; ++k)
       EXPECT_EQ(sum(k), expected(k)) << "entry " << k;  // bitwise: same operands, one addition
     EXPECT_EQ(sum.row(3).squaredNorm(), 0.0);
-    const PaddedMat<3> unchanged = padded<3, 3>(a);
-    EXPECT_TRUE(s == unchanged);  // s itself
   }
   Mat<2> s2, m2, sum2;
   s2 << 1, 2, 3, 4;

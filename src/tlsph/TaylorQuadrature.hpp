@@ -253,8 +253,8 @@ class TaylorQuadrature {
   // words (a store-to-load forwarding stall per column, issue 12).
   void paddedStressAt(Index i, const PaddedMat<D>& F, const FitSum& M, const Mat<D>& Pm,
                       PaddedMat<D>& stress) {
-    PaddedMat<D> Pq = PaddedMat<D>::Zero();  // a local, in registers; P^q stays zero when
-    if (weight_[i] == 0.0) {                 // there is no correction (R_i stays zero)
+    PaddedMat<D> Pq = PaddedMat<D>::Zero();  // P^q: zero where there is no correction
+    if (weight_[i] == 0.0) {                 // (R_i stays zero)
       addTop<D>(Pq, Pm, stress);
       return;
     }

@@ -501,13 +501,10 @@ class TlsphForces {
         const Mat<D> P = firstPiolaKirchhoff<D>(*model, F);
         if constexpr (!Taylor) P_[i] = P;
         if constexpr (Taylor) {
-          if constexpr (D == 3) {
+          if constexpr (D == 3)
             q->paddedStressAt(i, Fp, M, P, taylorStress[i]);
-          } else {
-            PaddedMat<D> S = q->stressAt(i, F, Gs);  // P^q
-            S.template topRows<D>() += P;
-            taylorStress[i] = S;
-          }
+          else
+            addTop<D>(q->stressAt(i, F, Gs), P, taylorStress[i]);  // P^q + P
         }
       }
     }
