@@ -10,7 +10,9 @@
 #   defaults: dx 0.0125 (5,312 particles), steps 200, procs "1 2" (MACHDYN: MPI ranks, one
 #   OpenMP thread each; tlsph: OpenMP threads, one process). Issue 12's sizes: 0.0125 2000 and
 #   0.00625 200. Environment: MPIRUN (default mpirun), HG (both codes' hourglass coefficient,
-#   default 10), CFL (default 0.3), PAIRED=1 (one core each, both codes at once; below).
+#   default 10), CFL (default 0.3), PAIRED=1 (one core each, both codes at once; below),
+#   ROUNDS=N (the codes in turn, N times, each tlsph rate against the MACHDYN runs either side of
+#   it; below).
 #
 # Equal in both codes: the particles (cell-centred cubic lattice of spacing dx: an 80 x 8 x 8 body
 # at dx 0.0125 plus ceil(2.1) = 3 clamp layers at x < 0 that never move), volume dx^3, density
@@ -136,6 +138,60 @@ if [ "${PAIRED:-0}" = 1 ]; then
       ratio=$(awk -v a="$rate" -v b="$md" 'BEGIN {printf "%.2f", a / b}')
       printf "%-18s %-9s %12.4g %-9s %12.4g %9s\n" "$config" "core $cm" "$md" "core $ct" \
         "$rate" "$ratio"
+    done
+  done
+  exit 0
+fi
+# ROUNDS=N: for runs that need every core (two ranks, two threads), where PAIRED cannot be used:
+# MACHDYN, tlsph, MACHDYN, tlsph, ..., MACHDYN. Each tlsph rate is divided by the mean of the two
+# MACHDYN runs either side of it, and the median of the N ratios is printed. tlsph runs its
+# benchmark REPEAT times back to back in each turn (default: as many as fill MACHDYN's first
+# run's wall time, at most 20), so that both codes sample the host over about the same minutes.
+if [ -n "${ROUNDS:-}" ]; then
+  [ -x build/tlsph_bench ] || { echo "(no build/tlsph_bench: build tlsph to compare)"; exit 0; }
+  extra=$(build/tlsph_bench --help | grep -q -- --no-stream && echo --no-stream)
+  machdyn_rate() {  # $1 ranks; prints particle-steps/s and the loop's wall time
+    local log=$work/log.rounds
+    OMP_NUM_THREADS=1 $MPIRUN -np "$1" "$LMP" -in "$work/in.cantilever" -log "$log" \
+      -screen none -var dx "$dx" -var nx "$nx" -var ny "$ny" -var layers "$layers" \
+      -var support "$support" -var hg "$HG" -var dt "$dt" -var steps "$steps" \
+      >"$work/out.rounds" 2>&1
+    grep -s "^Loop time of" "$log" | tail -1 | awk '{print $12 * $9 / $4, $4}'
+  }
+  tlsph_rate() {  # $1 threads, $2 repeats, rest: bench arguments; prints the mean rate and wall
+    local threads=$1 repeat=$2; shift 2
+    for ((r = 0; r < repeat; ++r)); do
+      OMP_NUM_THREADS=$threads build/tlsph_bench "$@" 2>&1 |
+        grep -o "wall [0-9.e+-]* s, particle-steps/s [0-9.e+-]*" | awk '{print $5, $2}'
+    done | awk '{n++; sum += $1; wall += $2} END {if (n) print sum / n, wall / n}'
+  }
+  printf "%-18s %5s %5s %12s %12s %12s %9s\n" config procs round "MACHDYN" "tlsph" "MACHDYN" \
+    tlsph/MD
+  for config in "bench-default" "quadratic-taylor"; do
+    args="--dx $dx --steps $steps --alpha $HG $extra"
+    [ "$config" = quadratic-taylor ] && args="$args --correction quadratic --quadrature taylor"
+    for p in $procs; do
+      read -r before mdwall < <(machdyn_rate "$p")
+      [ -n "${before:-}" ] || { echo "MACHDYN on $p ranks failed:"; tail -n 5 "$work/out.rounds"; exit 1; }
+      repeat=${REPEAT:-}
+      ratios=()
+      for ((round = 1; round <= ROUNDS; ++round)); do
+        if [ -z "$repeat" ]; then  # one run to learn its wall time
+          read -r rate wall < <(tlsph_rate "$p" 1 $args)
+          repeat=$(awk -v m="$mdwall" -v t="$wall" 'BEGIN {r = int(m / t + 0.5); print r < 1 ? 1 : (r > 20 ? 20 : r)}')
+        fi
+        read -r rate wall < <(tlsph_rate "$p" "$repeat" $args)
+        read -r after mdwall < <(machdyn_rate "$p")
+        [ -n "${rate:-}" ] && [ -n "${after:-}" ] || { echo "round $round failed"; exit 1; }
+        ratio=$(awk -v a="$rate" -v b="$before" -v c="$after" 'BEGIN {printf "%.2f", 2 * a / (b + c)}')
+        ratios+=("$ratio")
+        printf "%-18s %5s %5s %12.4g %12.4g %12.4g %9s\n" "$config" "$p" "$round" "$before" \
+          "$rate" "$after" "$ratio"
+        before=$after
+      done
+      printf "%-18s %5s %5s  median of %d ratios (tlsph %d x %d steps per turn): %s\n" "$config" \
+        "$p" - "$ROUNDS" "$repeat" "$steps" \
+        "$(printf "%s\n" "${ratios[@]}" | sort -g | awk '{v[NR] = $1} END {print NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2}')"
     done
   done
   exit 0
