@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
@@ -16,6 +17,7 @@
 #include <vector>
 
 #include "ProgramRunner.hpp"
+#include "app/Checkpoint.hpp"
 #include "app/OutputDirectory.hpp"
 #include "output/CheckpointArchive.hpp"
 #include "output/CsvSeries.hpp"
@@ -290,6 +292,37 @@ TEST_F(CheckpointRestart, ForeignCheckpointsAreRefused) {
       dir_ / "h.log");
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.output.find("no checkpoint of scene"), std::string::npos) << r.output;
+}
+
+// A checkpoint records its particles as numbered and placed: a build of tlsph that numbers the
+// same scene's particles otherwise (LocalityOrder.hpp) refuses it rather than continue the run
+// with every particle's state on another particle.
+TEST(CheckpointOrigin, ParticlesNumberedOtherwiseAreRefused) {
+  using namespace tlsph;
+  std::vector<Vec<2>> X = {Vec<2>(0.005, 0.005), Vec<2>(0.015, 0.005), Vec<2>(0.005, 0.015)};
+  const std::string digest = particleDigest<2>(X);
+  EXPECT_EQ(digest.rfind("3 particles, FNV-1a ", 0), 0u) << digest;
+  EXPECT_EQ(particleDigest<2>(X), digest);  // a function of the positions only
+  std::swap(X[1], X[2]);
+  const std::string renumbered = particleDigest<2>(X);
+  EXPECT_NE(renumbered, digest);
+  X[2].x() = std::nextafter(X[2].x(), 1.0);  // one position's last bit
+  EXPECT_NE(particleDigest<2>(X), renumbered);
+
+  CheckpointOrigin saved;
+  saved.version = "0.1.0";
+  saved.settings = {{"scene.dx", "0.01"}};
+  saved.particles = digest;
+  EXPECT_EQ(checkpointMismatch(saved, "0.1.0", saved.settings, digest), "");
+  const std::string why = checkpointMismatch(saved, "0.1.0", saved.settings, renumbered);
+  EXPECT_NE(why.find(digest), std::string::npos) << why;
+  EXPECT_NE(why.find(renumbered), std::string::npos) << why;
+  saved.particles.clear();  // a checkpoint of a tlsph that did not record them
+  EXPECT_NE(checkpointMismatch(saved, "0.1.0", saved.settings, digest).find("does not record"),
+            std::string::npos);
+  // a changed setting is named first
+  EXPECT_NE(checkpointMismatch(saved, "0.1.0", {{"scene.dx", "0.02"}}, digest).find("[scene] dx"),
+            std::string::npos);
 }
 
 TEST(CheckpointArchive, RoundTripsBlocksAndRefusesDamage) {

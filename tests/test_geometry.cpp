@@ -1,5 +1,6 @@
 // Geometry: shapes are closed and exact, lattice fills give every cell centre inside a union of
-// shapes once, x fastest, and degenerate input is rejected with a message naming the problem.
+// shapes once, x fastest (a scene then numbers them with its longest axis slowest), and degenerate
+// input is rejected with a message naming the problem.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -11,6 +12,7 @@
 #include <vector>
 
 #include "geometry/LatticeFill.hpp"
+#include "geometry/LocalityOrder.hpp"
 #include "tlsph/Lattice.hpp"
 
 using namespace tlsph;
@@ -520,3 +522,55 @@ TEST(LatticeFill, MaxPointsGuard) {
 }
 
 }  // namespace
+
+// LocalityOrder.hpp: the longest axis slowest puts every neighbour within a few cross-sections
+// of a particle's index; the lattice fill's order (x fastest) puts it whole x-y layers away.
+TEST(LocalityOrder, NeighboursOfABeamAreWithinAFewCrossSections) {
+  const double dx = 0.0125, H = 2.1 * dx;
+  auto X = cellCentredLattice<3>(Vec3::Zero(), {80, 8, 8}, dx);
+  auto widestReach = [&](const std::vector<Vec3>& points) {
+    long widest = 0;
+    for (std::size_t i = 0; i < points.size(); ++i)
+      for (std::size_t j = 0; j < points.size(); ++j)
+        if ((points[i] - points[j]).norm() < H)
+          widest = std::max(widest, std::labs(long(i) - long(j)));
+    return widest;
+  };
+  EXPECT_GE(widestReach(X), 2 * 80 * 8);  // two x-y layers of 640
+  sortForLocality<3>(X);
+  EXPECT_LT(widestReach(X), 3 * 8 * 8);  // two cross-sections of 64 and one less than a third
+  // x slowest, then z, then y (extents 1, 0.1, 0.1: equal extents keep the fill's z over y)
+  EXPECT_EQ((localityAxes<3>(X)), (std::array<int, 3>{0, 2, 1}));
+  for (std::size_t i = 1; i < X.size(); ++i)
+    ASSERT_TRUE(X[i - 1][0] < X[i][0] || (X[i - 1][0] == X[i][0] && X[i - 1][2] < X[i][2]) ||
+                (X[i - 1][0] == X[i][0] && X[i - 1][2] == X[i][2] && X[i - 1][1] < X[i][1]))
+        << i;
+}
+
+TEST(LocalityOrder, ACubeKeepsTheFillsOrderAndAnyInputOrderGivesTheSame) {
+  const double dx = 0.1;
+  const auto cube = cellCentredLattice<3>(Vec3::Zero(), {5, 5, 5}, dx);
+  auto sorted = cube;
+  sortForLocality<3>(sorted);
+  EXPECT_EQ(sorted, cube);
+  // a plate thin in x and longest in y: y slowest, x fastest
+  auto plate = cellCentredLattice<3>(Vec3::Zero(), {3, 12, 7}, dx);
+  EXPECT_EQ((localityAxes<3>(plate)), (std::array<int, 3>{1, 2, 0}));
+  auto shuffled = plate;
+  std::reverse(shuffled.begin(), shuffled.end());
+  std::rotate(shuffled.begin(), shuffled.begin() + 40, shuffled.end());
+  sortForLocality<3>(plate);
+  sortForLocality<3>(shuffled);
+  EXPECT_EQ(shuffled, plate);
+  for (std::size_t i = 1; i < plate.size(); ++i)
+    ASSERT_LE(plate[i - 1][1], plate[i][1]) << i;
+  // 2D: a bar along x is numbered with x slowest
+  auto bar = cellCentredLattice<2>(Vec<2>::Zero(), {20, 4}, dx);
+  sortForLocality<2>(bar);
+  EXPECT_EQ((localityAxes<2>(bar)), (std::array<int, 2>{0, 1}));
+  for (std::size_t i = 1; i < bar.size(); ++i)
+    ASSERT_LE(bar[i - 1][0], bar[i][0]) << i;
+  std::vector<Vec<2>> none;
+  sortForLocality<2>(none);  // no points: nothing to do
+  EXPECT_TRUE(none.empty());
+}

@@ -2,8 +2,10 @@
 // expected; good input builds the scene it describes.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
+#include <random>
 #include <sstream>
 #include <string>
 
@@ -234,13 +236,29 @@ TEST(SceneInput, GhostsContinueTheExactLattice) {
   const auto setup = buildScene<2>(Config::parse(kGood, "scene.ini"));
   const auto& X = setup.scene.particles.referencePosition;
   ASSERT_GT(setup.scene.mirrorGhosts.size(), 0u);
-  const double spacing = X[1][0] - X[0][0];  // two neighbours along x in the body
+  const double spacing = (X[1] - X[0]).norm();  // two neighbours in the body (along y)
   EXPECT_NEAR(spacing, 0.01, 1e-15);
   for (const auto& x : X)
     for (int a = 0; a < 2; ++a) {
       const double offset = x[a] - X[0][a];
       ASSERT_EQ(offset, std::round(offset / spacing) * spacing) << x.transpose();
     }
+}
+
+// The bodies are numbered with their longest axis slowest (LocalityOrder.hpp): the 0.2 x 0.04
+// bar column by column along x, the ghosts after them.
+TEST(SceneInput, BodiesAreNumberedWithTheLongestAxisSlowest) {
+  const auto setup = buildScene<2>(Config::parse(kGood, "scene.ini"));
+  const auto& X = setup.scene.particles.referencePosition;
+  ASSERT_EQ(setup.body.size(), X.size());
+  Index bodies = 0;
+  while (bodies < static_cast<Index>(X.size()) && setup.ghost[bodies] == 0)
+    ++bodies;
+  EXPECT_EQ(bodies, 20 * 4);
+  for (Index i = 1; i < bodies; ++i)
+    ASSERT_TRUE(X[i - 1][0] < X[i][0] || (X[i - 1][0] == X[i][0] && X[i - 1][1] < X[i][1])) << i;
+  for (Index i = bodies; i < static_cast<Index>(X.size()); ++i)
+    EXPECT_EQ(setup.ghost[i], 1);
 }
 
 // Region faces through cell centres: which particles a region selects is decided at
@@ -340,6 +358,27 @@ TEST(SceneInput, RandomInitialVelocityIsSeededAndBounded) {
   EXPECT_GT(largest, 0.4);  // the components fill [-0.5, 0.5]
   EXPECT_LT(std::abs(mean / a.size()), 0.1);
   EXPECT_THROW(velocities("seed = 1\n", "0"), InputError);
+}
+
+// The draws follow the lattice (y slowest, x fastest), not the particles' numbering (x slowest
+// for this bar): a particle's velocity depends on its place only.
+TEST(SceneInput, RandomInitialVelocityIsDrawnInTheLatticesOrder) {
+  const SceneSetup<2> s = buildScene<2>(Config::parse(
+      kGood + "[initial.kick]\nprofile = random\namplitude = 0.5\nseed = 7\n", "scene.ini"));
+  const auto& X = s.scene.particles.referencePosition;
+  std::vector<Index> lattice;
+  for (Index i = 0; i < static_cast<Index>(X.size()); ++i)
+    if (s.ghost[i] == 0) lattice.push_back(i);
+  ASSERT_EQ(lattice.size(), 80u);
+  std::sort(lattice.begin(), lattice.end(), [&](Index i, Index j) {
+    return X[i].y() < X[j].y() || (X[i].y() == X[j].y() && X[i].x() < X[j].x());
+  });
+  EXPECT_NE(lattice[1], 1);  // the numbering is not the lattice's order
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  for (Index i : lattice)
+    for (int a = 0; a < 2; ++a)
+      ASSERT_EQ(s.scene.particles.velocity[i][a], 0.5 * unit(rng)) << i;
 }
 
 // The Taylor quadrature warns (naming the material) on a nearly incompressible material, where

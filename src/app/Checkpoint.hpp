@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -37,7 +38,24 @@ struct CheckpointOrigin {
   std::vector<std::string> overrides;
   std::vector<std::pair<std::string, std::string>> settings;  // Config::settings()
   int threads = 1;
+  // The scene's particles as numbered and placed (particleDigest): a tlsph that numbers or
+  // places them otherwise from the same scene (LocalityOrder.hpp) cannot continue the run.
+  std::string particles;
 };
+
+// "N particles, FNV-1a <hex>" over the bytes of the reference positions in their order.
+template <int D>
+std::string particleDigest(const std::vector<Vec<D>>& X) {
+  std::uint64_t h = 14695981039346656037ull;
+  for (const auto& x : X) {
+    const auto* b = reinterpret_cast<const unsigned char*>(x.data());
+    for (std::size_t k = 0; k < sizeof(double) * D; ++k)
+      h = (h ^ b[k]) * 1099511628211ull;
+  }
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+  return std::to_string(X.size()) + " particles, FNV-1a " + hex;
+}
 
 template <int D>
 struct Checkpoint {
@@ -96,6 +114,7 @@ void writeCheckpoint(const std::filesystem::path& file, const Checkpoint<D>& c) 
   }
   w.putString("settings", joinWithNul(flat));
   w.put("threads", static_cast<std::int32_t>(c.origin.threads));
+  w.putString("particles", c.origin.particles);
 
   const SolverState<D>& s = c.solver;
   w.put("time", s.time);
@@ -162,6 +181,7 @@ inline CheckpointOrigin readCheckpointOrigin(const CheckpointReader& r) {
   for (std::size_t k = 0; k + 1 < flat.size(); k += 2)
     o.settings.emplace_back(flat[k], flat[k + 1]);
   o.threads = r.get<std::int32_t>("threads");
+  if (r.has("particles")) o.particles = r.getString("particles");
   return o;
 }
 
@@ -244,10 +264,12 @@ Checkpoint<D> readCheckpoint(const CheckpointReader& r) {
   return c;
 }
 
-// Why a checkpoint cannot continue this run ("" if it can): another tlsph version, or a scene
-// whose settings differ (the first difference is named; [checkpoint] settings may change).
+// Why a checkpoint cannot continue this run ("" if it can): another tlsph version, a scene
+// whose settings differ (the first difference is named; [checkpoint] settings may change), or
+// particles numbered or placed otherwise (particleDigest).
 inline std::string checkpointMismatch(const CheckpointOrigin& saved, const std::string& version,
-                                      const std::vector<std::pair<std::string, std::string>>& now) {
+                                      const std::vector<std::pair<std::string, std::string>>& now,
+                                      const std::string& particles) {
   using checkpoint_detail::restartMayChange;
   if (saved.version != version)
     return "it was written by tlsph " + saved.version + ", this is tlsph " + version +
@@ -275,6 +297,12 @@ inline std::string checkpointMismatch(const CheckpointOrigin& saved, const std::
     ++i;
     ++j;
   }
+  if (saved.particles != particles)
+    return saved.particles.empty()
+               ? "it does not record its scene's particles (written by an earlier tlsph, which "
+                 "may number them otherwise)"
+               : "its scene's particles were " + saved.particles + ", this scene's are " +
+                     particles + " (numbered or placed otherwise by the tlsph that wrote it)";
   return "";
 }
 

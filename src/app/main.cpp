@@ -275,6 +275,7 @@ int runOrCheck(const Config& config, bool run, bool progress, const std::string&
   options.progress = progress;
   options.command = command;
   options.origin = runOrigin(config, flags, threads);
+  options.origin.particles = particleDigest<D>(setup.scene.particles.referencePosition);
   options.comm = comm;
 
   std::optional<Checkpoint<D>> resume;
@@ -283,8 +284,8 @@ int runOrCheck(const Config& config, bool run, bool progress, const std::string&
                               ? CheckpointSchedule::latest(setup.output.directory, setup.name)
                               : fs::path(flags.restart);
     const CheckpointReader reader(file);
-    const std::string why =
-        checkpointMismatch(readCheckpointOrigin(reader), kVersion, options.origin.settings);
+    const std::string why = checkpointMismatch(readCheckpointOrigin(reader), kVersion,
+                                               options.origin.settings, options.origin.particles);
     if (!why.empty())
       throw CheckpointError("cannot restart from checkpoint " + file.string() + ": " + why);
     resume = readCheckpoint<D>(reader);

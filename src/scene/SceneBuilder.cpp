@@ -1,5 +1,6 @@
 #include "scene/SceneBuilder.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <filesystem>
@@ -13,6 +14,7 @@
 #include <stdexcept>
 
 #include "geometry/LatticeFill.hpp"
+#include "geometry/LocalityOrder.hpp"
 #include "geometry/Shape.hpp"
 #include "scene/SectionReader.hpp"
 #include "tlsph/Kernel.hpp"
@@ -326,6 +328,8 @@ class Builder {
       throw InputError(config_.where(hole, "shape"), hole, "shape",
                        "the holes remove every particle of the bodies");
     }
+    // Numbered with the longest axis slowest (the pair loops' locality, LocalityOrder.hpp).
+    sortForLocality<D>(points);
     const double V = std::pow(setup_.dx, D);
     auto& p = setup_.scene.particles;
     for (const auto& X : points) {
@@ -721,12 +725,22 @@ class Builder {
           r.word("profile", "constant", {"constant", "beam-mode", "rotation", "random"});
       if (profile == "random") {
         // Each component uniform in [-amplitude, amplitude], from a seeded generator: a
-        // reproducible excitation of every mode, the spurious ones included.
+        // reproducible excitation of every mode, the spurious ones included. Drawn in the
+        // lattice's order (the last axis slowest, x fastest), not the particles' numbering, so
+        // that a particle's velocity depends on its place only (LocalityOrder.hpp numbers the
+        // particles otherwise).
         const double amplitude = r.positive("amplitude");
         const long seed = r.integer("seed", 1);
         std::mt19937_64 rng(static_cast<std::uint64_t>(seed));
         std::uniform_real_distribution<double> unit(-1.0, 1.0);
-        for (Index i : particles)
+        std::vector<Index> drawOrder(particles);
+        const auto& X = p.referencePosition;
+        std::sort(drawOrder.begin(), drawOrder.end(), [&](Index i, Index j) {
+          for (int a = D - 1; a >= 0; --a)
+            if (X[i][a] != X[j][a]) return X[i][a] < X[j][a];
+          return i < j;
+        });
+        for (Index i : drawOrder)
           for (int a = 0; a < D; ++a)
             p.velocity[i][a] = amplitude * unit(rng);
         setup_.conditions.push_back("initial." + name + ": random velocity, components up to " +
@@ -912,11 +926,20 @@ class Builder {
                                           "'; expected displacement, velocity, cauchy_stress");
       r.finish();
       if (probe.method == ProbeMethod::Nearest) {
+        // Of equally near particles, the first in the lattice's order (the last axis slowest):
+        // the choice depends on the particles' places, not on their numbering.
+        const auto& X = p.referencePosition;
+        auto before = [&](Index i, Index j) {
+          const double di = (X[i] - probe.point).squaredNorm(),
+                       dj = (X[j] - probe.point).squaredNorm();
+          if (di != dj) return di < dj;
+          for (int a = D - 1; a >= 0; --a)
+            if (X[i][a] != X[j][a]) return X[i][a] < X[j][a];
+          return false;
+        };
         Index best = 0;
         for (Index i = 1; i < bodyCount_; ++i)
-          if ((p.referencePosition[i] - probe.point).squaredNorm() <
-              (p.referencePosition[best] - probe.point).squaredNorm())
-            best = i;
+          if (before(i, best)) best = i;
         probe.particles = {best};
         probe.weights = {1.0};
       } else {
