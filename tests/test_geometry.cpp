@@ -574,3 +574,20 @@ TEST(LocalityOrder, ACubeKeepsTheFillsOrderAndAnyInputOrderGivesTheSame) {
   sortForLocality<2>(none);  // no points: nothing to do
   EXPECT_TRUE(none.empty());
 }
+
+TEST(LocalityOrder, LatticeOrderBeforeIsTheFillsOrder) {
+  // the lattice fill numbers x fastest and the last axis slowest; latticeOrderBefore orders
+  // the fill's points exactly as it made them, whatever order they are handed in
+  const auto block = cellCentredLattice<3>(Vec3::Zero(), {4, 3, 5}, 0.1);
+  for (std::size_t i = 1; i < block.size(); ++i) {
+    ASSERT_TRUE(latticeOrderBefore<3>(block[i - 1], block[i])) << i;
+    ASSERT_FALSE(latticeOrderBefore<3>(block[i], block[i - 1])) << i;
+  }
+  EXPECT_FALSE(latticeOrderBefore<3>(block[7], block[7]));  // strict: a point is not before itself
+  auto shuffled = block;
+  sortForLocality<3>(shuffled);  // numbered otherwise (z slowest here, then x)
+  EXPECT_NE(shuffled, block);
+  std::sort(shuffled.begin(), shuffled.end(),
+            [](const Vec3& p, const Vec3& q) { return latticeOrderBefore<3>(p, q); });
+  EXPECT_EQ(shuffled, block);
+}

@@ -49,4 +49,14 @@ void sortForLocality(std::vector<Vec<D>>& points) {
   });
 }
 
+// The lattice fill's own order (the last axis slowest, x fastest), compared exactly: where a
+// choice must depend on the particles' places and not on how LocalityOrder numbered them (a
+// random field's draw order, a nearest probe's tie).
+template <int D>
+bool latticeOrderBefore(const Vec<D>& p, const Vec<D>& q) {
+  for (int a = D - 1; a >= 0; --a)
+    if (p[a] != q[a]) return p[a] < q[a];
+  return false;
+}
+
 }  // namespace tlsph

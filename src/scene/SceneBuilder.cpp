@@ -726,7 +726,7 @@ class Builder {
       if (profile == "random") {
         // Each component uniform in [-amplitude, amplitude], from a seeded generator: a
         // reproducible excitation of every mode, the spurious ones included. Drawn in the
-        // lattice's order (the last axis slowest, x fastest), not the particles' numbering, so
+        // lattice's order (latticeOrderBefore), not the particles' numbering, so
         // that a particle's velocity depends on its place only (LocalityOrder.hpp numbers the
         // particles otherwise).
         const double amplitude = r.positive("amplitude");
@@ -735,11 +735,8 @@ class Builder {
         std::uniform_real_distribution<double> unit(-1.0, 1.0);
         std::vector<Index> drawOrder(particles);
         const auto& X = p.referencePosition;
-        std::sort(drawOrder.begin(), drawOrder.end(), [&](Index i, Index j) {
-          for (int a = D - 1; a >= 0; --a)
-            if (X[i][a] != X[j][a]) return X[i][a] < X[j][a];
-          return i < j;
-        });
+        std::stable_sort(drawOrder.begin(), drawOrder.end(),
+                         [&](Index i, Index j) { return latticeOrderBefore<D>(X[i], X[j]); });
         for (Index i : drawOrder)
           for (int a = 0; a < D; ++a)
             p.velocity[i][a] = amplitude * unit(rng);
@@ -926,16 +923,14 @@ class Builder {
                                           "'; expected displacement, velocity, cauchy_stress");
       r.finish();
       if (probe.method == ProbeMethod::Nearest) {
-        // Of equally near particles, the first in the lattice's order (the last axis slowest):
+        // Of equally near particles, the first in the lattice's order (latticeOrderBefore):
         // the choice depends on the particles' places, not on their numbering.
         const auto& X = p.referencePosition;
         auto before = [&](Index i, Index j) {
           const double di = (X[i] - probe.point).squaredNorm(),
                        dj = (X[j] - probe.point).squaredNorm();
           if (di != dj) return di < dj;
-          for (int a = D - 1; a >= 0; --a)
-            if (X[i][a] != X[j][a]) return X[i][a] < X[j][a];
-          return false;
+          return latticeOrderBefore<D>(X[i], X[j]);
         };
         Index best = 0;
         for (Index i = 1; i < bodyCount_; ++i)
