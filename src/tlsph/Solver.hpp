@@ -16,6 +16,7 @@
 #include "tlsph/DomainPartition.hpp"
 #include "tlsph/Errors.hpp"
 #include "tlsph/OrderedSum.hpp"
+#include "tlsph/ParallelFor.hpp"
 #include "tlsph/ReferenceConfiguration.hpp"
 #include "tlsph/ReproducibleSum.hpp"
 #include "tlsph/Scene.hpp"
@@ -320,12 +321,12 @@ class Solver {
       // The peak test decides the trajectory: its kinetic energy is summed with bits that do
       // not depend on the order, the threads or the ranks (ReproducibleSum.hpp).
       kineticTerms_.resize(ownFree_.size());
-      for (std::size_t k = 0; k < ownFree_.size(); ++k)
+      parallelFor(nFree, [&](Index k) {
         kineticTerms_[k] = 0.5 * p.mass[ownFree_[k]] * p.velocity[ownFree_[k]].squaredNorm();
+      });
       kinetic = reproducibleSum(kineticTerms_, comm_);
       if (kinetic < previousKinetic_) {  // just past a peak: take the kinetic energy out
-        for (Index i : ownFree_)
-          p.velocity[i].setZero();
+        parallelFor(nFree, [&](Index k) { p.velocity[ownFree_[k]].setZero(); });
         dampingWork += kinetic;
         kinetic = 0.0;
         ++kineticResets_;
@@ -772,8 +773,8 @@ class Solver {
   void computeExternalForces(double t) {
     auto& p = scene_.particles;
     const Vec<D> g = scene_.gravity * scene_.gravityRamp.factor(t);
-    for (Index i = 0; i < p.size(); ++i)
-      external_[i] = p.mass[i] * g;
+    // by the threads that read it in the kicks (ParallelFor.hpp)
+    parallelFor(p.size(), [&](Index i) { external_[i] = p.mass[i] * g; });
     for (const auto& load : scene_.loads) {
       const double f = load.ramp.factor(t);
       for (std::size_t k = 0; k < load.particles.size(); ++k)
