@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "tlsph/MeetInTheMiddle.hpp"
 #include "tlsph/Padded.hpp"
 #include "tlsph/Prefetch.hpp"
 #include "tlsph/ReferenceConfiguration.hpp"
@@ -59,45 +60,50 @@ class EnergyHourglass {
   // neighbours' F ahead (Prefetch.hpp; when F is read from memory).
   template <bool Gradient = false, bool Gather = false, class U, class FM, class PM, class SM>
   void evaluate(std::span<const U> u, std::span<const FM> F, const PM* P, std::span<SM> stress,
-                const std::vector<Index>* particles = nullptr) {
+                const std::vector<Index>* particles = nullptr, MeetInTheMiddle* split = nullptr) {
     constexpr int R = U::RowsAtCompileTime;  // D, or 4 when padded
     using Row = Eigen::Matrix<double, R, 1>;
     using Moment = Eigen::Matrix<double, R, D>;
     const auto& nb = ref_.neighbours;
     const Index count = particles ? static_cast<Index>(particles->size()) : ref_.particleCount();
     const Index* list = particles ? particles->data() : nullptr;
-#pragma omp parallel for schedule(static)
-    for (Index p = 0; p < count; ++p) {
-      const Index i = list ? list[p] : p;
-      const Row ui = u[i];
-      Row sum = Row::Zero();
-      Moment moment = Moment::Zero();
-      const PaddedVec<D>* X = separation_.row(i);
-      const double* c = c_.row(i);
-      for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k, ++X, ++c) {
-        const Index j = nb.neighbour[k];
-        prefetchAhead(X);
-        prefetchAhead(c);
-        if constexpr (Gather) prefetchGather(F.data(), j);
-        const Vec<D> Xij = X->template head<D>();
-        const Row HjX = Gradient ? Row(F[j] * Xij) : Row(F[j] * Xij - X->template head<R>());
-        const Row w = *c * ((ui - u[j]) - 0.5 * HjX);
-        sum += w;
-        moment.noalias() += w * Xij.transpose();
-      }
-      const auto Fi = F[i].template topRows<D>();
-      const Mat<D> Hi = Gradient ? Mat<D>(Fi) : Mat<D>(Fi - Mat<D>::Identity());
-      Vec<D> sumD = sum.template head<D>();
-      Mat<D> momentD = moment.template topRows<D>();
-      sumD -= 0.5 * (Hi * sumCX_[i]);                // sum_J c_IJ e_IJ
-      momentD.noalias() -= 0.5 * (Hi * sumCXX_[i]);  // sum_J c_IJ e_IJ (x) X_IJ
-      // P + P^hg, written as expressions: a Mat = Mat copy here is an out-of-line call once
-      // the unit holds enough of them, and that spills the loop's sums to memory
-      if (P)
-        stress[i].template topRows<D>().noalias() = P[i].template topRows<D>() - 0.5 * momentD;
-      else
-        stress[i].template topRows<D>().noalias() = -0.5 * momentD;
-      spring_[i] = -volume_[i] * sumD;  // -sum_J k_IJ e_IJ
+    if (split) split->reset(count);
+#pragma omp parallel
+    {
+      MeetInTheMiddle::Chunks chunks(split, count);
+      for (Index a, b; chunks.next(a, b);)
+        for (Index p = a; p < b; ++p) {
+          const Index i = list ? list[p] : p;
+          const Row ui = u[i];
+          Row sum = Row::Zero();
+          Moment moment = Moment::Zero();
+          const PaddedVec<D>* X = separation_.row(i);
+          const double* c = c_.row(i);
+          for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k, ++X, ++c) {
+            const Index j = nb.neighbour[k];
+            prefetchAhead(X);
+            prefetchAhead(c);
+            if constexpr (Gather) prefetchGather(F.data(), j);
+            const Vec<D> Xij = X->template head<D>();
+            const Row HjX = Gradient ? Row(F[j] * Xij) : Row(F[j] * Xij - X->template head<R>());
+            const Row w = *c * ((ui - u[j]) - 0.5 * HjX);
+            sum += w;
+            moment.noalias() += w * Xij.transpose();
+          }
+          const auto Fi = F[i].template topRows<D>();
+          const Mat<D> Hi = Gradient ? Mat<D>(Fi) : Mat<D>(Fi - Mat<D>::Identity());
+          Vec<D> sumD = sum.template head<D>();
+          Mat<D> momentD = moment.template topRows<D>();
+          sumD -= 0.5 * (Hi * sumCX_[i]);                // sum_J c_IJ e_IJ
+          momentD.noalias() -= 0.5 * (Hi * sumCXX_[i]);  // sum_J c_IJ e_IJ (x) X_IJ
+          // P + P^hg, written as expressions: a Mat = Mat copy here is an out-of-line call once
+          // the unit holds enough of them, and that spills the loop's sums to memory
+          if (P)
+            stress[i].template topRows<D>().noalias() = P[i].template topRows<D>() - 0.5 * momentD;
+          else
+            stress[i].template topRows<D>().noalias() = -0.5 * momentD;
+          spring_[i] = -volume_[i] * sumD;  // -sum_J k_IJ e_IJ
+        }
     }
   }
 

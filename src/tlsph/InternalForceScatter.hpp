@@ -11,10 +11,11 @@
 //
 // Threads: each owns a contiguous range of targets and visits every source with a neighbour in
 // that range (a sorted row: one sub-range of it); a source near the edge of two ranges is
-// visited by both, each of its pairs by one. No atomics, and a target's terms arrive in the
-// same order whatever the number of threads. A distributed rank's sources are the particles
-// with a list (its own and its halo, whose S and R the halo exchange brought); targets that are
-// not its own are summed too, and never read.
+// visited by both, each of its pairs by one. The ranges are where the threads met in the pass
+// before (MeetInTheMiddle.hpp), any split being as good for the bits. No atomics, and a
+// target's terms arrive in the same order whatever the number of threads and the split. A
+// distributed rank's sources are the particles with a list (its own and its halo, whose S and R
+// the halo exchange brought); targets that are not its own are summed too, and never read.
 #pragma once
 
 #include <algorithm>
@@ -27,6 +28,7 @@
 #endif
 
 #include "tlsph/LargePageAllocator.hpp"
+#include "tlsph/MeetInTheMiddle.hpp"
 #include "tlsph/NeighbourList.hpp"
 #include "tlsph/Padded.hpp"
 #include "tlsph/Prefetch.hpp"
@@ -90,7 +92,8 @@ class InternalForceScatter {
   // the stress sent through t_IJ (padded or plain); R: the hyperstresses (Taylor).
   template <class SM, class Own, class Finish>
   void accumulate(const LargeArray<SM>& S, const LargeArray<PaddedSymMatrix>* R,
-                  const std::vector<Index>* targets, Own&& own, Finish&& finish) {
+                  const std::vector<Index>* targets, const MeetInTheMiddle& split, Own&& own,
+                  Finish&& finish) {
     const Index n = nb_.particleCount();
     const Index count = targets ? static_cast<Index>(targets->size()) : n;
     const bool listed = !sources_.empty();
@@ -102,7 +105,8 @@ class InternalForceScatter {
 #else
       const Index threads = 1, thread = 0;
 #endif
-      const Index p0 = count * thread / threads, p1 = count * (thread + 1) / threads;
+      // where the pass before met (a static share when it ran over other particles)
+      const auto [p0, p1] = split.shareOf(count, thread, threads);
       if (p0 < p1) {
         auto target = [&](Index p) { return targets ? (*targets)[p] : p; };
         const Index a = target(p0), b = p1 < count ? target(p1) : n;  // this thread's targets

@@ -27,6 +27,7 @@
 #include "tlsph/GanzenmuellerHourglass.hpp"
 #include "tlsph/HourglassStiffness.hpp"
 #include "tlsph/InternalForceScatter.hpp"
+#include "tlsph/MeetInTheMiddle.hpp"
 #include "tlsph/OrderedSum.hpp"
 #include "tlsph/Padded.hpp"
 #include "tlsph/PairTerms.hpp"
@@ -452,61 +453,66 @@ class TlsphForces {
     [[maybe_unused]] TaylorQuadrature<D>* q = quadrature_.get();
     // P + P^q where the penalty adds P^hg in place, else its own array
     [[maybe_unused]] auto& taylorStress = penaltyReadsF() ? stress_ : quadratureStress_;
-#pragma omp parallel for schedule(static)
-    for (Index p = 0; p < count; ++p) {
-      const Index i = group[p];
-      // deformationGradientOf written out: the hot loop measured 2-3 % slower through the call
-      Mat<D> F;
-      [[maybe_unused]] typename TaylorQuadrature<D>::SymMatrix Gs;  // 2D
-      [[maybe_unused]] typename TaylorQuadrature<D>::FitSum M;      // 3D: [grad u | Gs]
-      [[maybe_unused]] PaddedMat<D> Fp;                             // 3D: F padded
-      if constexpr (Taylor && D == 3) {
-        q->paddedGradients(i, paddedU_, M);  // grad u and grad grad u in one pass, padded
-        Fp = padded<D, D>(Mat<D>::Identity()) + M.template leftCols<D>();  // (6.69)
-        F = Fp.template topRows<D>();
-      } else if constexpr (PaddedF && !Taylor) {
-        // 3D nodal with the penalty on F: the sums padded like the fit's above (u_J one 256-bit
-        // load, a column one 4-wide multiply-add), the same products in the same order
-        const PaddedVec<D> ui = paddedU_[i];
-        PaddedMat<D> gradU = PaddedMat<D>::Zero();
-        const Vec<D>* g = correctedGradient_.row(i);
-        for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k, ++g) {
-          prefetchAhead(g);
-          const PaddedVec<D> du = paddedU_[nb.neighbour[k]] - ui;
-          for (int m = 0; m < D; ++m)
-            gradU.col(m).noalias() += du * (*g)[m];
-        }
-        Fp = padded<D, D>(Mat<D>::Identity()) + gradU;  // (6.69)
-        F = Fp.template topRows<D>();
-      } else {
-        Mat<D> gradU;
-        if constexpr (Taylor) {
-          q->gradients(i, u, gradU, Gs);  // grad u and grad grad u in one pass
-        } else {
-          const Vec<D> ui = u[i];
-          gradU.setZero();
-          const Vec<D>* g = correctedGradient_.row(i);
-          for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k, ++g) {
-            prefetchAhead(g);
-            gradU.noalias() += (u[nb.neighbour[k]] - ui) * g->transpose();
+    split_.reset(count);
+#pragma omp parallel
+    {
+      MeetInTheMiddle::Chunks chunks(&split_, count);
+      for (Index a, b; chunks.next(a, b);)
+        for (Index p = a; p < b; ++p) {
+          const Index i = group[p];
+          // deformationGradientOf written out: the hot loop measured 2-3 % slower through the call
+          Mat<D> F;
+          [[maybe_unused]] typename TaylorQuadrature<D>::SymMatrix Gs;  // 2D
+          [[maybe_unused]] typename TaylorQuadrature<D>::FitSum M;      // 3D: [grad u | Gs]
+          [[maybe_unused]] PaddedMat<D> Fp;                             // 3D: F padded
+          if constexpr (Taylor && D == 3) {
+            q->paddedGradients(i, paddedU_, M);  // grad u and grad grad u in one pass, padded
+            Fp = padded<D, D>(Mat<D>::Identity()) + M.template leftCols<D>();  // (6.69)
+            F = Fp.template topRows<D>();
+          } else if constexpr (PaddedF && !Taylor) {
+            // 3D nodal with the penalty on F: the sums padded like the fit's above (u_J one 256-bit
+            // load, a column one 4-wide multiply-add), the same products in the same order
+            const PaddedVec<D> ui = paddedU_[i];
+            PaddedMat<D> gradU = PaddedMat<D>::Zero();
+            const Vec<D>* g = correctedGradient_.row(i);
+            for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k, ++g) {
+              prefetchAhead(g);
+              const PaddedVec<D> du = paddedU_[nb.neighbour[k]] - ui;
+              for (int m = 0; m < D; ++m)
+                gradU.col(m).noalias() += du * (*g)[m];
+            }
+            Fp = padded<D, D>(Mat<D>::Identity()) + gradU;  // (6.69)
+            F = Fp.template topRows<D>();
+          } else {
+            Mat<D> gradU;
+            if constexpr (Taylor) {
+              q->gradients(i, u, gradU, Gs);  // grad u and grad grad u in one pass
+            } else {
+              const Vec<D> ui = u[i];
+              gradU.setZero();
+              const Vec<D>* g = correctedGradient_.row(i);
+              for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k, ++g) {
+                prefetchAhead(g);
+                gradU.noalias() += (u[nb.neighbour[k]] - ui) * g->transpose();
+              }
+            }
+            F = Mat<D>::Identity() + gradU;  // (6.69)
+          }
+          if constexpr (PaddedF)
+            paddedPenaltyF_[i] = Fp;
+          else
+            F_[i] = F;
+          if constexpr (!std::is_void_v<Model>) {
+            const Mat<D> P = firstPiolaKirchhoff<D>(*model, F);
+            if constexpr (!Taylor) P_[i] = P;
+            if constexpr (Taylor) {
+              if constexpr (D == 3)
+                q->paddedStressAt(i, Fp, M, P, taylorStress[i]);
+              else
+                addTop<D>(q->stressAt(i, F, Gs), P, taylorStress[i]);  // P^q + P
+            }
           }
         }
-        F = Mat<D>::Identity() + gradU;  // (6.69)
-      }
-      if constexpr (PaddedF)
-        paddedPenaltyF_[i] = Fp;
-      else
-        F_[i] = F;
-      if constexpr (!std::is_void_v<Model>) {
-        const Mat<D> P = firstPiolaKirchhoff<D>(*model, F);
-        if constexpr (!Taylor) P_[i] = P;
-        if constexpr (Taylor) {
-          if constexpr (D == 3)
-            q->paddedStressAt(i, Fp, M, P, taylorStress[i]);
-          else
-            addTop<D>(q->stressAt(i, F, Gs), P, taylorStress[i]);  // P^q + P
-        }
-      }
     }
     if (separateHourglassGradient_) {
 #pragma omp parallel for schedule(static)
@@ -550,9 +556,10 @@ class TlsphForces {
       uh = u;
     std::span<const PaddedMat<D>> F = penaltyGradient();
     if (prefetchGathers_)
-      energyHourglass_->template evaluate<false, true>(uh, F, P, std::span(stress_), owned);
+      energyHourglass_->template evaluate<false, true>(uh, F, P, std::span(stress_), owned,
+                                                       &split_);
     else
-      energyHourglass_->evaluate(uh, F, P, std::span(stress_), owned);
+      energyHourglass_->evaluate(uh, F, P, std::span(stress_), owned, &split_);
   }
 
   // t^lin_IJ = (V_J / V_I) g^lin_JI and G^lin_I, for the energy penalty on the linear F when
@@ -620,51 +627,57 @@ class TlsphForces {
     const Index* owned = comm_ ? owned_.data() : nullptr;
     const LargeArray<Mat<D>>& Fh = separateHourglassGradient_ ? hourglassF_ : F_;
     [[maybe_unused]] const TaylorQuadrature<D>* q = quadrature_.get();
-#pragma omp parallel for schedule(static)
-    for (Index p = 0; p < count; ++p) {
-      const Index i = owned ? owned[p] : p;
-      // (6.70) as a force: f_I = V_I (S_I G_I - sum_J S_J t_IJ)
-      PaddedVec<D> internal = PaddedVec<D>::Zero();
-      internal.template head<R>().noalias() = S[i] * ref_.correctedGradientSum[i];
-      Vec<D> hourglass = Vec<D>::Zero(), viscous = Vec<D>::Zero();
-      const Vec<D> ui = u[i];
-      if constexpr (SeparateHourglassStress) internal += stress_[i] * linearSum_[i];
-      if constexpr (Taylor) internal += q->hyperForceOwn(i);  // through grad grad u
-      // particle i's rows of t_IJ (and t^lin_IJ, T_IJ), advanced with k
-      const Vec<D>* t = reverseGradient_.row(i);
-      [[maybe_unused]] const Vec<D>* tLinear =
-          SeparateHourglassStress ? linearReverse_.row(i) : nullptr;
-      [[maybe_unused]] const auto* T = Taylor ? q->reverseRow(i) : nullptr;
-      for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k, ++t) {
-        const Index j = nb.neighbour[k];
-        prefetchAhead(t);
-        if constexpr (Gather) prefetchGather(S.data(), j);
-        internal.template head<R>().noalias() -= S[j] * *t;
-        if constexpr (SeparateHourglassStress) {
-          prefetchAhead(tLinear);
-          internal.noalias() -= stress_[j] * *tLinear++;
+    split_.reset(count);
+#pragma omp parallel
+    {
+      MeetInTheMiddle::Chunks chunks(&split_, count);
+      for (Index a, b; chunks.next(a, b);)
+        for (Index p = a; p < b; ++p) {
+          const Index i = owned ? owned[p] : p;
+          // (6.70) as a force: f_I = V_I (S_I G_I - sum_J S_J t_IJ)
+          PaddedVec<D> internal = PaddedVec<D>::Zero();
+          internal.template head<R>().noalias() = S[i] * ref_.correctedGradientSum[i];
+          Vec<D> hourglass = Vec<D>::Zero(), viscous = Vec<D>::Zero();
+          const Vec<D> ui = u[i];
+          if constexpr (SeparateHourglassStress) internal += stress_[i] * linearSum_[i];
+          if constexpr (Taylor) internal += q->hyperForceOwn(i);  // through grad grad u
+          // particle i's rows of t_IJ (and t^lin_IJ, T_IJ), advanced with k
+          const Vec<D>* t = reverseGradient_.row(i);
+          [[maybe_unused]] const Vec<D>* tLinear =
+              SeparateHourglassStress ? linearReverse_.row(i) : nullptr;
+          [[maybe_unused]] const auto* T = Taylor ? q->reverseRow(i) : nullptr;
+          for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k, ++t) {
+            const Index j = nb.neighbour[k];
+            prefetchAhead(t);
+            if constexpr (Gather) prefetchGather(S.data(), j);
+            internal.template head<R>().noalias() -= S[j] * *t;
+            if constexpr (SeparateHourglassStress) {
+              prefetchAhead(tLinear);
+              internal.noalias() -= stress_[j] * *tLinear++;
+            }
+            if constexpr (Taylor) internal.noalias() -= q->template hyperForcePair<Gather>(T++, j);
+            if constexpr (Ganzenmueller || Viscous) {
+              prefetchAhead(&ref_.separation[k]);
+              const Vec<D>& Xij = ref_.separation[k];
+              const Vec<D> xij = Xij + (ui - u[j]);
+              if constexpr (Ganzenmueller)
+                hourglass += ganzenmueller_->pair(k, Xij, xij, Fh[i], Fh[j]);
+              if constexpr (Viscous)
+                viscous += viscosity_->pair(k, xij, (*velocity)[i] - (*velocity)[j]);
+            }
+          }
+          Vec<D> total = volume_[i] * internal.template head<D>();
+          if (energyHourglass_) total += energyHourglass_->springForce(i);
+          if constexpr (Ganzenmueller) {
+            hourglassForce_[i] = volume_[i] * hourglass;
+            total += hourglassForce_[i];
+          }
+          if constexpr (Viscous) {
+            viscousForce_[i] = volume_[i] * viscous;
+            total += viscousForce_[i];
+          }
+          f[i] = total;
         }
-        if constexpr (Taylor) internal.noalias() -= q->template hyperForcePair<Gather>(T++, j);
-        if constexpr (Ganzenmueller || Viscous) {
-          prefetchAhead(&ref_.separation[k]);
-          const Vec<D>& Xij = ref_.separation[k];
-          const Vec<D> xij = Xij + (ui - u[j]);
-          if constexpr (Ganzenmueller) hourglass += ganzenmueller_->pair(k, Xij, xij, Fh[i], Fh[j]);
-          if constexpr (Viscous)
-            viscous += viscosity_->pair(k, xij, (*velocity)[i] - (*velocity)[j]);
-        }
-      }
-      Vec<D> total = volume_[i] * internal.template head<D>();
-      if (energyHourglass_) total += energyHourglass_->springForce(i);
-      if constexpr (Ganzenmueller) {
-        hourglassForce_[i] = volume_[i] * hourglass;
-        total += hourglassForce_[i];
-      }
-      if constexpr (Viscous) {
-        viscousForce_[i] = volume_[i] * viscous;
-        total += viscousForce_[i];
-      }
-      f[i] = total;
     }
   }
 
@@ -676,7 +689,7 @@ class TlsphForces {
     constexpr int R = SM::RowsAtCompileTime;
     [[maybe_unused]] const TaylorQuadrature<D>* q = quadrature_.get();
     scatter.accumulate(
-        S, Taylor ? &q->hyperstresses() : nullptr, comm_ ? &owned_ : nullptr,
+        S, Taylor ? &q->hyperstresses() : nullptr, comm_ ? &owned_ : nullptr, split_,
         [&](Index i) {
           PaddedVec<D> own = PaddedVec<D>::Zero();
           own.template head<R>().noalias() = S[i] * ref_.correctedGradientSum[i];
@@ -728,6 +741,9 @@ class TlsphForces {
   std::unique_ptr<InternalForceScatter<D, false>> nodalScatter_;
   bool scatter_ = true;
   mutable bool observed_ = true;  // observe() has run since the last compute()
+  // The pair-loop passes' particles shared by pairs of threads that meet (MeetInTheMiddle.hpp);
+  // the source-scatter force pass splits where the pass before it met.
+  MeetInTheMiddle split_;
 };
 
 extern template class TlsphForces<2>;
