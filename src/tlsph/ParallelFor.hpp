@@ -1,6 +1,7 @@
-// A loop over the indices 0..n-1 split among the OpenMP threads the way the pair passes split
-// theirs (static: contiguous ranges of equal length), for the solver's per-particle loops. Each
-// thread then writes the particles whose cache lines its core already holds: on two threads a
+// A loop over the indices 0..n-1 split among the OpenMP threads in contiguous ranges of equal
+// length, for the solver's per-particle loops: the static shares the pair passes' threads start
+// from and meet near (MeetInTheMiddle.hpp). Each thread then mostly writes the particles whose
+// cache lines its core already holds: on two threads a
 // per-particle array written by one thread alone moved half its lines between the cores every
 // step (issue 12, docs/performance.md).
 #pragma once
