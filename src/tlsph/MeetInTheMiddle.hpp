@@ -16,7 +16,7 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
-#include <memory>
+#include <vector>
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -42,10 +42,9 @@ class MeetInTheMiddle {
 #else
     const int threads = 1;
 #endif
-    if (threads / 2 > pairCapacity_) {
-      pairCapacity_ = threads / 2;
-      pairs_ = std::make_unique<Pair[]>(static_cast<std::size_t>(pairCapacity_));
-    }
+    // a Pair cannot move (its atomic), so a larger thread count takes a new vector
+    if (static_cast<std::size_t>(threads / 2) > pairs_.size())
+      pairs_ = std::vector<Pair>(static_cast<std::size_t>(threads / 2));
     count_ = count;
     threads_ = threads;
     for (int k = 0; k < threads / 2; ++k) {
@@ -135,8 +134,7 @@ class MeetInTheMiddle {
     return {staticBegin(count_, 2 * k, threads_), staticBegin(count_, 2 * k + 2, threads_)};
   }
 
-  std::unique_ptr<Pair[]> pairs_;
-  int pairCapacity_ = 0;
+  std::vector<Pair> pairs_;
   Index count_ = -1;
   int threads_ = 0;
 };
