@@ -54,6 +54,8 @@ class MeetInTheMiddle {
   }
 
   // Inside the region, one per thread: the chunks [a, b) it computes, one after the other.
+  // (The passes write this loop out: a helper taking the pass's body as a lambda measured
+  // 10-13 % slower, paired, one thread; GCC compiled the body worse.)
   // From split (reset() for this pass) when given, else the thread's static share.
   class Chunks {
    public:
