@@ -5,6 +5,9 @@
 // energy density over the body (the nodal sum alone misses 1/n^2 of the bending energy).
 #include <gtest/gtest.h>
 
+#include <bit>
+#include <cstdint>
+
 #include "DifferencedStiffness.hpp"
 #include "TestSupport.hpp"
 #include "tlsph/DofMap.hpp"
@@ -74,6 +77,41 @@ TEST(TaylorQuadrature, ForceIsMinusEnergyGradient3D) {
   for (const char* m : {"saint-venant-kirchhoff", "neo-hookean"})
     for (double alpha : {0.0, 10.0})
       expectForceIsMinusEnergyGradient<3>(m, alpha, 12);
+}
+
+// The F pass sums two particles at once (issue 12): each particle's [grad u | Gs] must be the
+// bits of its own sum, whatever its partner and whichever row is longer (a jittered block:
+// rows of different lengths), with the padding row zero.
+TEST(TaylorQuadrature, TwoParticleSumsAreEachParticlesOwn) {
+  std::mt19937 rng(31);
+  ForceEvaluator<3> eval(blockScene<3>("neo-hookean", 10.0, 0.15, rng));
+  const TaylorQuadrature<3>& q = *eval.forces().quadrature();
+  const Index n = eval.size();
+  std::vector<PaddedVec<3>> u(n, PaddedVec<3>::Zero());
+  for (Index i = 0; i < n; ++i)
+    u[i].head<3>() = randomVector<3>(rng, 0.1 * kDx);
+  const auto& nb = eval.reference().neighbours;
+  int unequalRows = 0;
+  for (Index i0 = 0; i0 < n; ++i0)
+    for (Index i1 : {(i0 + 1) % n, (i0 + 7) % n, i0}) {
+      TaylorQuadrature<3>::FitSum one0, one1, two0, two1;
+      q.paddedGradients(i0, u, one0);
+      q.paddedGradients(i1, u, one1);
+      q.paddedGradients(i0, i1, u, two0, two1);
+      unequalRows += nb.offset[i0 + 1] - nb.offset[i0] != nb.offset[i1 + 1] - nb.offset[i1];
+      for (int m = 0; m < one0.cols(); ++m)
+        for (int a = 0; a < 4; ++a) {
+          ASSERT_EQ(std::bit_cast<std::uint64_t>(two0(a, m)),
+                    std::bit_cast<std::uint64_t>(one0(a, m)))
+              << "particle " << i0 << " with " << i1 << ", entry (" << a << ", " << m << ")";
+          ASSERT_EQ(std::bit_cast<std::uint64_t>(two1(a, m)),
+                    std::bit_cast<std::uint64_t>(one1(a, m)))
+              << "particle " << i1 << " with " << i0 << ", entry (" << a << ", " << m << ")";
+        }
+      EXPECT_EQ(one0.row(3).squaredNorm(), 0.0);
+      EXPECT_GT(one0.topRows<3>().squaredNorm(), 0.0);
+    }
+  EXPECT_GT(unequalRows, n);  // the tails of the longer row are exercised
 }
 
 template <int D>

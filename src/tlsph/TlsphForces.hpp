@@ -453,63 +453,75 @@ class TlsphForces {
     [[maybe_unused]] TaylorQuadrature<D>* q = quadrature_.get();
     // P + P^q where the penalty adds P^hg in place, else its own array
     [[maybe_unused]] auto& taylorStress = penaltyReadsF() ? stress_ : quadratureStress_;
+    constexpr Index kFitBatch = Taylor && D == 3 ? 2 : 1;
     split_.reset(count);
 #pragma omp parallel
     {
       MeetInTheMiddle::Chunks chunks(&split_, count);
       for (Index a, b; chunks.next(a, b);)
-        for (Index p = a; p < b; ++p) {
-          const Index i = group[p];
-          // deformationGradientOf written out: the hot loop measured 2-3 % slower through the call
-          Mat<D> F;
-          [[maybe_unused]] typename TaylorQuadrature<D>::SymMatrix Gs;  // 2D
-          [[maybe_unused]] typename TaylorQuadrature<D>::FitSum M;      // 3D: [grad u | Gs]
-          [[maybe_unused]] PaddedMat<D> Fp;                             // 3D: F padded
+        for (Index p0 = a; p0 < b; p0 += kFitBatch) {
+          // 3D Taylor: two particles' sums at once (TaylorQuadrature::paddedGradients)
+          [[maybe_unused]] typename TaylorQuadrature<D>::FitSum Ms[kFitBatch];  // [grad u | Gs]
           if constexpr (Taylor && D == 3) {
-            q->paddedGradients(i, paddedU_, M);  // grad u and grad grad u in one pass, padded
-            Fp = padded<D, D>(Mat<D>::Identity()) + M.template leftCols<D>();  // (6.69)
-            F = Fp.template topRows<D>();
-          } else if constexpr (PaddedF && !Taylor) {
-            // 3D nodal with the penalty on F: the sums padded like the fit's above (u_J one 256-bit
-            // load, a column one 4-wide multiply-add), the same products in the same order
-            const PaddedVec<D> ui = paddedU_[i];
-            PaddedMat<D> gradU = PaddedMat<D>::Zero();
-            const Vec<D>* g = correctedGradient_.row(i);
-            for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k, ++g) {
-              prefetchAhead(g);
-              const PaddedVec<D> du = paddedU_[nb.neighbour[k]] - ui;
-              for (int m = 0; m < D; ++m)
-                gradU.col(m).noalias() += du * (*g)[m];
-            }
-            Fp = padded<D, D>(Mat<D>::Identity()) + gradU;  // (6.69)
-            F = Fp.template topRows<D>();
-          } else {
-            Mat<D> gradU;
-            if constexpr (Taylor) {
-              q->gradients(i, u, gradU, Gs);  // grad u and grad grad u in one pass
-            } else {
-              const Vec<D> ui = u[i];
-              gradU.setZero();
+            if (p0 + 1 < b)
+              q->paddedGradients(group[p0], group[p0 + 1], paddedU_, Ms[0], Ms[kFitBatch - 1]);
+            else
+              q->paddedGradients(group[p0], paddedU_, Ms[0]);
+          }
+          for (Index p = p0; p < std::min(b, p0 + kFitBatch); ++p) {
+            const Index i = group[p];
+            // deformationGradientOf written out: the hot loop measured 2-3 % slower through the
+            // call
+            Mat<D> F;
+            [[maybe_unused]] typename TaylorQuadrature<D>::SymMatrix Gs;  // 2D
+            [[maybe_unused]] PaddedMat<D> Fp;                             // 3D: F padded
+            if constexpr (Taylor && D == 3) {
+              const auto& M = Ms[p - p0];
+              Fp = padded<D, D>(Mat<D>::Identity()) + M.template leftCols<D>();  // (6.69)
+              F = Fp.template topRows<D>();
+            } else if constexpr (PaddedF && !Taylor) {
+              // 3D nodal with the penalty on F: the sums padded like the fit's above (u_J one
+              // 256-bit load, a column one 4-wide multiply-add), the same products in the same
+              // order
+              const PaddedVec<D> ui = paddedU_[i];
+              PaddedMat<D> gradU = PaddedMat<D>::Zero();
               const Vec<D>* g = correctedGradient_.row(i);
               for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k, ++g) {
                 prefetchAhead(g);
-                gradU.noalias() += (u[nb.neighbour[k]] - ui) * g->transpose();
+                const PaddedVec<D> du = paddedU_[nb.neighbour[k]] - ui;
+                for (int m = 0; m < D; ++m)
+                  gradU.col(m).noalias() += du * (*g)[m];
               }
+              Fp = padded<D, D>(Mat<D>::Identity()) + gradU;  // (6.69)
+              F = Fp.template topRows<D>();
+            } else {
+              Mat<D> gradU;
+              if constexpr (Taylor) {
+                q->gradients(i, u, gradU, Gs);  // grad u and grad grad u in one pass
+              } else {
+                const Vec<D> ui = u[i];
+                gradU.setZero();
+                const Vec<D>* g = correctedGradient_.row(i);
+                for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k, ++g) {
+                  prefetchAhead(g);
+                  gradU.noalias() += (u[nb.neighbour[k]] - ui) * g->transpose();
+                }
+              }
+              F = Mat<D>::Identity() + gradU;  // (6.69)
             }
-            F = Mat<D>::Identity() + gradU;  // (6.69)
-          }
-          if constexpr (PaddedF)
-            paddedPenaltyF_[i] = Fp;
-          else
-            F_[i] = F;
-          if constexpr (!std::is_void_v<Model>) {
-            const Mat<D> P = firstPiolaKirchhoff<D>(*model, F);
-            if constexpr (!Taylor) P_[i] = P;
-            if constexpr (Taylor) {
-              if constexpr (D == 3)
-                q->paddedStressAt(i, Fp, M, P, taylorStress[i]);
-              else
-                addTop<D>(q->stressAt(i, F, Gs), P, taylorStress[i]);  // P^q + P
+            if constexpr (PaddedF)
+              paddedPenaltyF_[i] = Fp;
+            else
+              F_[i] = F;
+            if constexpr (!std::is_void_v<Model>) {
+              const Mat<D> P = firstPiolaKirchhoff<D>(*model, F);
+              if constexpr (!Taylor) P_[i] = P;
+              if constexpr (Taylor) {
+                if constexpr (D == 3)
+                  q->paddedStressAt(i, Fp, Ms[p - p0], P, taylorStress[i]);
+                else
+                  addTop<D>(q->stressAt(i, F, Gs), P, taylorStress[i]);  // P^q + P
+              }
             }
           }
         }
