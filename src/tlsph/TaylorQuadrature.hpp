@@ -264,13 +264,19 @@ class TaylorQuadrature {
       const Index end0 = nb.offset[i0 + 1], end1 = nb.offset[i1 + 1];
       for (const Index both = k0 + std::min(end0 - k0, end1 - k1); k0 < both;
            ++k0, ++k1, fit0 += D + P, fit1 += D + P) {
+        prefetchAhead(fit0);
+        prefetchAhead(fit1);
         s0.add(u[j[k0]], fit0);
         s1.add(u[j[k1]], fit1);
       }
-      for (; k0 < end0; ++k0, fit0 += D + P)
+      for (; k0 < end0; ++k0, fit0 += D + P) {
+        prefetchAhead(fit0);
         s0.add(u[j[k0]], fit0);
-      for (; k1 < end1; ++k1, fit1 += D + P)
+      }
+      for (; k1 < end1; ++k1, fit1 += D + P) {
+        prefetchAhead(fit1);
         s1.add(u[j[k1]], fit1);
+      }
       s0.store(out0);
       s1.store(out1);
       return;
@@ -336,40 +342,43 @@ class TaylorQuadrature {
 #if defined(__AVX512F__)
   // One particle's [grad u | Gs] in the two-particle paddedGradients: rows a = 0..2 of its
   // first eight columns, each entry fma(du_a, c_m, sum) as there, and its last column padded.
+  // (named members, no arrays: GCC kept arrays of them on the stack, stored every pair)
   struct Sums {
-    __m512d row[3];
+    __m512d row0, row1, row2;
     __m256d last;
-    __m512d ui[3];  // u_I's entries, broadcast
-    __m256d uiPadded;
-    explicit Sums(const PaddedVec<D>& u) requires(D == 3) {
-      for (int a = 0; a < 3; ++a) {
-        row[a] = _mm512_setzero_pd();
-        ui[a] = _mm512_set1_pd(u[a]);
-      }
-      last = _mm256_setzero_pd();
-      uiPadded = _mm256_loadu_pd(u.data());
-    }
-    // one pair: u_J and the record [g_IJ, S_IJ] (nine doubles)
+    __m512d ui0, ui1, ui2;  // u_I's entries, broadcast
+    __m256d ui;
+    explicit Sums(const PaddedVec<D>& u) requires(D == 3)
+        : row0(_mm512_setzero_pd()),
+          row1(_mm512_setzero_pd()),
+          row2(_mm512_setzero_pd()),
+          last(_mm256_setzero_pd()),
+          ui0(_mm512_set1_pd(u[0])),
+          ui1(_mm512_set1_pd(u[1])),
+          ui2(_mm512_set1_pd(u[2])),
+          ui(_mm256_loadu_pd(u.data())) {}
+    // one pair: u_J and the record [g_IJ, S_IJ] (nine doubles; the caller prefetches them: in
+    // here GCC dropped the prefetch); du_a broadcast as u_J's entry from memory minus u_I's
     [[gnu::always_inline]] void add(const PaddedVec<D>& uj, const double* c) requires(D == 3) {
-      prefetchAhead(c);
       const __m512d first = _mm512_loadu_pd(c);
-      for (int a = 0; a < 3; ++a)  // du_a broadcast: u_J's entry from memory minus u_I's
-        row[a] = _mm512_fmadd_pd(_mm512_sub_pd(_mm512_set1_pd(uj[a]), ui[a]), first, row[a]);
-      last = _mm256_fmadd_pd(_mm256_sub_pd(_mm256_loadu_pd(uj.data()), uiPadded),
+      row0 = _mm512_fmadd_pd(_mm512_sub_pd(_mm512_set1_pd(uj[0]), ui0), first, row0);
+      row1 = _mm512_fmadd_pd(_mm512_sub_pd(_mm512_set1_pd(uj[1]), ui1), first, row1);
+      row2 = _mm512_fmadd_pd(_mm512_sub_pd(_mm512_set1_pd(uj[2]), ui2), first, row2);
+      last = _mm256_fmadd_pd(_mm256_sub_pd(_mm256_loadu_pd(uj.data()), ui),
                              _mm256_broadcast_sd(c + 8), last);
     }
     // the low (h = 0) or high four entries (the masked extract: GCC 12 warns on the undefined
     // source of the plain one and of the cast)
-    static __m256d half(__m512d r, int h) {
+    [[gnu::always_inline]] static __m256d half(__m512d r, int h) {
       return h ? _mm512_mask_extractf64x4_pd(_mm256_setzero_pd(), 0xf, r, 1)
                : _mm512_mask_extractf64x4_pd(_mm256_setzero_pd(), 0xf, r, 0);
     }
     // M's columns (padded, fourth row zero), transposed in registers (stored whole: the stress
     // reads them as 256-bit words)
-    void store(FitSum& M) const requires(D == 3) {
+    [[gnu::always_inline]] void store(FitSum& M) const requires(D == 3) {
       const __m256d zero = _mm256_setzero_pd();
       for (int h = 0; h < 2; ++h) {  // columns 4h .. 4h + 3
-        const __m256d r0 = half(row[0], h), r1 = half(row[1], h), r2 = half(row[2], h);
+        const __m256d r0 = half(row0, h), r1 = half(row1, h), r2 = half(row2, h);
         const __m256d t0 = _mm256_unpacklo_pd(r0, r1);    // r00 r10 | r02 r12
         const __m256d t1 = _mm256_unpackhi_pd(r0, r1);    // r01 r11 | r03 r13
         const __m256d t2 = _mm256_unpacklo_pd(r2, zero);  // r20 0 | r22 0
