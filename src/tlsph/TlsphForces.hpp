@@ -453,20 +453,26 @@ class TlsphForces {
     [[maybe_unused]] TaylorQuadrature<D>* q = quadrature_.get();
     // P + P^q where the penalty adds P^hg in place, else its own array
     [[maybe_unused]] auto& taylorStress = penaltyReadsF() ? stress_ : quadratureStress_;
-    constexpr Index kFitBatch = Taylor && D == 3 ? 2 : 1;
+    constexpr Index kFitBatch = D == 3 && (Taylor || PaddedF) ? 2 : 1;
     split_.reset(count);
 #pragma omp parallel
     {
       MeetInTheMiddle::Chunks chunks(&split_, count);
       for (Index a, b; chunks.next(a, b);)
         for (Index p0 = a; p0 < b; p0 += kFitBatch) {
-          // 3D Taylor: two particles' sums at once (TaylorQuadrature::paddedGradients)
+          // 3D: two particles' sums at once (TaylorQuadrature::paddedGradients, paddedGradU)
           [[maybe_unused]] typename TaylorQuadrature<D>::FitSum Ms[kFitBatch];  // [grad u | Gs]
+          [[maybe_unused]] PaddedMat<D> gradUs[kFitBatch];  // 3D nodal: grad u padded
           if constexpr (Taylor && D == 3) {
             if (p0 + 1 < b)
               q->paddedGradients(group[p0], group[p0 + 1], paddedU_, Ms[0], Ms[kFitBatch - 1]);
             else
               q->paddedGradients(group[p0], paddedU_, Ms[0]);
+          } else if constexpr (PaddedF) {
+            if (p0 + 1 < b)
+              paddedGradU(group[p0], group[p0 + 1], gradUs[0], gradUs[kFitBatch - 1]);
+            else
+              paddedGradU(group[p0], group[p0], gradUs[0], gradUs[0], 1);
           }
           for (Index p = p0; p < std::min(b, p0 + kFitBatch); ++p) {
             const Index i = group[p];
@@ -480,18 +486,7 @@ class TlsphForces {
               Fp = padded<D, D>(Mat<D>::Identity()) + M.template leftCols<D>();  // (6.69)
               F = Fp.template topRows<D>();
             } else if constexpr (PaddedF && !Taylor) {
-              // 3D nodal with the penalty on F: the sums padded like the fit's above (u_J one
-              // 256-bit load, a column one 4-wide multiply-add), the same products in the same
-              // order
-              const PaddedVec<D> ui = paddedU_[i];
-              PaddedMat<D> gradU = PaddedMat<D>::Zero();
-              const Vec<D>* g = correctedGradient_.row(i);
-              for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k, ++g) {
-                prefetchAhead(g);
-                const PaddedVec<D> du = paddedU_[nb.neighbour[k]] - ui;
-                for (int m = 0; m < D; ++m)
-                  gradU.col(m).noalias() += du * (*g)[m];
-              }
+              const PaddedMat<D>& gradU = gradUs[p - p0];
               Fp = padded<D, D>(Mat<D>::Identity()) + gradU;  // (6.69)
               F = Fp.template topRows<D>();
             } else {
@@ -535,6 +530,47 @@ class TlsphForces {
           if (energyHourglass_) paddedPenaltyF_[i].template topRows<D>() = hourglassF_[i];
       }
     }
+  }
+
+  // 3D nodal with the penalty on F: grad u of particles i0 and i1 (the first `count`), the sums
+  // padded like the Taylor fit's (u_J one 256-bit load, a column one 4-wide multiply-add), the
+  // two particles' pairs interleaved: one particle's three column sums are chains of 4-cycle
+  // multiply-adds, two particles' six keep the pipes busy (issue 12). Each column the same
+  // products in the same order.
+  [[gnu::always_inline]] void paddedGradU(Index i0, Index i1, PaddedMat<D>& gradU0,
+                                          PaddedMat<D>& gradU1, int count = 2) const {
+    const Index* j = ref_.neighbours.neighbour.data();
+    const Index* offset = ref_.neighbours.offset.data();
+    const PaddedVec<D> ui0 = paddedU_[i0], ui1 = paddedU_[i1];
+    PaddedMat<D> sum0 = PaddedMat<D>::Zero(), sum1 = PaddedMat<D>::Zero();
+    const Vec<D>* g0 = correctedGradient_.row(i0);
+    const Vec<D>* g1 = correctedGradient_.row(i1);
+    Index k0 = offset[i0], k1 = offset[i1];
+    const Index end0 = offset[i0 + 1], end1 = count == 2 ? offset[i1 + 1] : k1;
+    for (const Index both = k0 + std::min(end0 - k0, end1 - k1); k0 < both;
+         ++k0, ++k1, ++g0, ++g1) {
+      prefetchAhead(g0);
+      prefetchAhead(g1);
+      const PaddedVec<D> du0 = paddedU_[j[k0]] - ui0, du1 = paddedU_[j[k1]] - ui1;
+      for (int m = 0; m < D; ++m) {
+        sum0.col(m).noalias() += du0 * (*g0)[m];
+        sum1.col(m).noalias() += du1 * (*g1)[m];
+      }
+    }
+    for (; k0 < end0; ++k0, ++g0) {
+      prefetchAhead(g0);
+      const PaddedVec<D> du = paddedU_[j[k0]] - ui0;
+      for (int m = 0; m < D; ++m)
+        sum0.col(m).noalias() += du * (*g0)[m];
+    }
+    for (; k1 < end1; ++k1, ++g1) {
+      prefetchAhead(g1);
+      const PaddedVec<D> du = paddedU_[j[k1]] - ui1;
+      for (int m = 0; m < D; ++m)
+        sum1.col(m).noalias() += du * (*g1)[m];
+    }
+    gradU0 = sum0;
+    if (count == 2) gradU1 = sum1;
   }
 
   // The F the energy penalty gathers: in 3D a padded copy (Padded.hpp) of F or of the linear
