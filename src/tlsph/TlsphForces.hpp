@@ -472,7 +472,7 @@ class TlsphForces {
             if (p0 + 1 < b)
               paddedGradU(group[p0], group[p0 + 1], gradUs[0], gradUs[kFitBatch - 1]);
             else
-              paddedGradU(group[p0], group[p0], gradUs[0], gradUs[0], 1);
+              paddedGradU(group[p0], gradUs[0]);
           }
           for (Index p = p0; p < std::min(b, p0 + kFitBatch); ++p) {
             const Index i = group[p];
@@ -532,45 +532,47 @@ class TlsphForces {
     }
   }
 
-  // 3D nodal with the penalty on F: grad u of particles i0 and i1 (the first `count`), the sums
-  // padded like the Taylor fit's (u_J one 256-bit load, a column one 4-wide multiply-add), the
-  // two particles' pairs interleaved: one particle's three column sums are chains of 4-cycle
-  // multiply-adds, two particles' six keep the pipes busy (issue 12). Each column the same
-  // products in the same order.
+  // 3D nodal with the penalty on F: grad u of particles i0 and i1, the sums padded like the
+  // Taylor fit's (u_J one 256-bit load, a column one 4-wide multiply-add), the two particles'
+  // pairs interleaved: one particle's three column sums are chains of 4-cycle multiply-adds,
+  // two particles' six keep the pipes busy (issue 12). Each column the same products in the
+  // same order as the one-particle paddedGradU.
   [[gnu::always_inline]] void paddedGradU(Index i0, Index i1, PaddedMat<D>& gradU0,
-                                          PaddedMat<D>& gradU1, int count = 2) const {
-    const Index* j = ref_.neighbours.neighbour.data();
+                                          PaddedMat<D>& gradU1) const {
     const Index* offset = ref_.neighbours.offset.data();
     const PaddedVec<D> ui0 = paddedU_[i0], ui1 = paddedU_[i1];
     PaddedMat<D> sum0 = PaddedMat<D>::Zero(), sum1 = PaddedMat<D>::Zero();
     const Vec<D>* g0 = correctedGradient_.row(i0);
     const Vec<D>* g1 = correctedGradient_.row(i1);
     Index k0 = offset[i0], k1 = offset[i1];
-    const Index end0 = offset[i0 + 1], end1 = count == 2 ? offset[i1 + 1] : k1;
-    for (const Index both = k0 + std::min(end0 - k0, end1 - k1); k0 < both;
-         ++k0, ++k1, ++g0, ++g1) {
-      prefetchAhead(g0);
-      prefetchAhead(g1);
-      const PaddedVec<D> du0 = paddedU_[j[k0]] - ui0, du1 = paddedU_[j[k1]] - ui1;
-      for (int m = 0; m < D; ++m) {
-        sum0.col(m).noalias() += du0 * (*g0)[m];
-        sum1.col(m).noalias() += du1 * (*g1)[m];
-      }
+    const Index end0 = offset[i0 + 1], end1 = offset[i1 + 1];
+    for (const Index both = k0 + std::min(end0 - k0, end1 - k1); k0 < both; ++k0, ++k1) {
+      addPaddedPair(sum0, ui0, k0, g0++);
+      addPaddedPair(sum1, ui1, k1, g1++);
     }
-    for (; k0 < end0; ++k0, ++g0) {
-      prefetchAhead(g0);
-      const PaddedVec<D> du = paddedU_[j[k0]] - ui0;
-      for (int m = 0; m < D; ++m)
-        sum0.col(m).noalias() += du * (*g0)[m];
-    }
-    for (; k1 < end1; ++k1, ++g1) {
-      prefetchAhead(g1);
-      const PaddedVec<D> du = paddedU_[j[k1]] - ui1;
-      for (int m = 0; m < D; ++m)
-        sum1.col(m).noalias() += du * (*g1)[m];
-    }
+    for (; k0 < end0; ++k0)
+      addPaddedPair(sum0, ui0, k0, g0++);
+    for (; k1 < end1; ++k1)
+      addPaddedPair(sum1, ui1, k1, g1++);
     gradU0 = sum0;
-    if (count == 2) gradU1 = sum1;
+    gradU1 = sum1;
+  }
+  // One particle's (the last of a chunk with an odd count).
+  [[gnu::always_inline]] void paddedGradU(Index i, PaddedMat<D>& gradU) const {
+    const PaddedVec<D> ui = paddedU_[i];
+    PaddedMat<D> sum = PaddedMat<D>::Zero();
+    const Vec<D>* g = correctedGradient_.row(i);
+    for (Index k = ref_.neighbours.offset[i]; k < ref_.neighbours.offset[i + 1]; ++k)
+      addPaddedPair(sum, ui, k, g++);
+    gradU = sum;
+  }
+  // Pair k's term (u_J - u_I) (x) g_IJ of grad u, padded, g its gradient vector.
+  [[gnu::always_inline]] void addPaddedPair(PaddedMat<D>& sum, const PaddedVec<D>& ui, Index k,
+                                            const Vec<D>* g) const {
+    prefetchAhead(g);
+    const PaddedVec<D> du = paddedU_[ref_.neighbours.neighbour[k]] - ui;
+    for (int m = 0; m < D; ++m)
+      sum.col(m).noalias() += du * (*g)[m];
   }
 
   // The F the energy penalty gathers: in 3D a padded copy (Padded.hpp) of F or of the linear
