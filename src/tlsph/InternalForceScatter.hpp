@@ -17,7 +17,8 @@
 // distributed rank's sources are the particles with a list (its own and its halo, whose S and R
 // the halo exchange brought); targets that are not its own are summed too, and never read.
 //
-// In 3D a source's records are stored two pairs interleaved entry by entry (pairs 2b and 2b+1:
+// In 3D, when the stress is padded (the quadrature's, or P + P^hg; P alone is sent unpadded),
+// a source's records are stored two pairs interleaved entry by entry (pairs 2b and 2b+1:
 // t_0 t_0' t_1 t_1' t_2 t_2', then T_0 T_0' ... T_5 T_5' with the quadrature), so that with
 // AVX-512 one 512-bit multiply-add serves two pairs: the source's columns duplicated lane by
 // lane (S_0e S_0e S_1e S_1e ...) times one entry of both records (a 128-bit load, repeated),
@@ -60,16 +61,17 @@ class InternalForceScatter {
   // At source J's m-th pair (target I): t_IJ, and T_IJ with the quadrature.
   using Record = std::conditional_t<Taylor, Eigen::Matrix<double, D + P, 1>, Vec<D>>;
   static constexpr int E = Record::RowsAtCompileTime;  // entries per record
-  // Two records interleaved (3D), else one record as it is.
-  static constexpr bool kInterleaved = D == 3;
-  using Stored = std::conditional_t<kInterleaved, std::array<double, 2 * E>, Record>;
+  using RecordPair = std::array<double, 2 * E>;        // two records interleaved
 
   // t: the gather's rows of t_IJ (each target's own list); T: those of T_IJ (Taylor only).
   // Pairs whose target has no list (a distributed rank's halo edge) get zero: such targets
-  // are not the rank's.
+  // are not the rank's. paddedStress: accumulate() will be given a padded S (3D: the records
+  // are then stored in pairs).
   InternalForceScatter(const NeighbourList& nb, const SharedRows<Vec<D>>& t,
-                       const SharedRows<Sym>* T)
-      : nb_(nb), sums_(static_cast<std::size_t>(nb.particleCount()), PaddedVec<D>::Zero()) {
+                       const SharedRows<Sym>* T, bool paddedStress)
+      : nb_(nb),
+        interleaved_(D == 3 && paddedStress),
+        sums_(static_cast<std::size_t>(nb.particleCount()), PaddedVec<D>::Zero()) {
     PairArray<Record> records(nb.pairCount(), Record::Zero());
     const Index n = nb.particleCount();
     // each source's first and last target (its sorted row's ends; an empty row matches none)
@@ -96,15 +98,15 @@ class InternalForceScatter {
           records[k] = t.row(i)[m];
         }
       }
-    if constexpr (kInterleaved)
-      records_ = interleaved(nb, records);
+    if (interleaved_)
+      recordPairs_ = interleaved(nb, records);
     else
       records_ = SharedRows<Record>(nb, std::move(records));
   }
 
   // The bytes of the per-pair records the pass streams (each distinct row once).
   double storedPairBytes() const {
-    return records_.storedBytes();
+    return interleaved_ ? recordPairs_.storedBytes() : records_.storedBytes();
   }
 
   // For the targets (all particles, or the ascending list given): sum_i = own(i) minus the
@@ -154,7 +156,7 @@ class InternalForceScatter {
       ++k0;
     while (neighbour[k1 - 1] >= b)
       --k1;
-    if constexpr (kInterleaved)
+    if (interleaved_)
       scatterInterleaved(j, k0, k1, S, R);
     else
       scatterRecords(j, k0, k1, S, R);
@@ -186,15 +188,16 @@ class InternalForceScatter {
     }
   }
 
-  // The records two by two interleaved (3D). With AVX-512 and S padded, two pairs per
-  // 512-bit multiply-add; otherwise pair by pair.
+  // The records two by two interleaved (3D, S padded). With AVX-512 two pairs per 512-bit
+  // multiply-add; otherwise pair by pair.
   template <class SM>
   void scatterInterleaved(Index j, Index k0, Index k1, const LargeArray<SM>& S,
                           const LargeArray<PaddedSymMatrix>* R) {
     constexpr int Rows = SM::RowsAtCompileTime;
     const Index* neighbour = nb_.neighbour.data();
     const Index start = nb_.offset[j];
-    const double* records = records_.row(j)->data();  // entry e of pair m: [2E (m/2) + 2e + m%2]
+    // entry e of the row's pair m: records[2E (m/2) + 2e + m%2]
+    const double* records = recordPairs_.row(j)->data();
     PaddedVec<D>* sums = sums_.data();
 #if defined(__AVX512F__) && defined(__AVX512DQ__)
     if constexpr (Rows == 4) {
@@ -276,22 +279,25 @@ class InternalForceScatter {
 
   // The records of sources' pairs 2b and 2b+1 interleaved entry by entry (an odd row's last
   // record beside zeros), each distinct row of record pairs kept once.
-  static SharedRows<Stored> interleaved(const NeighbourList& nb, const PairArray<Record>& records) {
+  static SharedRows<RecordPair> interleaved(const NeighbourList& nb,
+                                            const PairArray<Record>& records) {
     NeighbourList pairsOfRows;  // the rows of record pairs (only the offsets are read)
     const Index n = nb.particleCount();
     pairsOfRows.offset.assign(static_cast<std::size_t>(n) + 1, 0);
     for (Index j = 0; j < n; ++j)
       pairsOfRows.offset[j + 1] = pairsOfRows.offset[j] + (nb.count(j) + 1) / 2;
-    PairArray<Stored> stored(static_cast<std::size_t>(pairsOfRows.offset[n]), Stored{});
+    PairArray<RecordPair> stored(static_cast<std::size_t>(pairsOfRows.offset[n]), RecordPair{});
     for (Index j = 0; j < n; ++j)
       for (Index m = 0; m < nb.count(j); ++m)
         for (int e = 0; e < E; ++e)
           stored[pairsOfRows.offset[j] + m / 2][2 * e + m % 2] = records[nb.offset[j] + m][e];
-    return SharedRows<Stored>(pairsOfRows, std::move(stored));
+    return SharedRows<RecordPair>(pairsOfRows, std::move(stored));
   }
 
   const NeighbourList& nb_;
-  SharedRows<Stored> records_;
+  bool interleaved_;                              // records_ empty, recordPairs_ used
+  SharedRows<Record> records_;                    // one pair's record after the other
+  SharedRows<RecordPair> recordPairs_;            // or two pairs' interleaved
   std::vector<std::array<Index, 2>> targetSpan_;  // per source: its first and last target
   std::vector<Index> sources_;     // the particles with a list, ascending; empty: all of them
   LargeArray<PaddedVec<D>> sums_;  // per target

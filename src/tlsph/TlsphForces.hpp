@@ -111,12 +111,13 @@ class TlsphForces {
     if (D == 3 && (quadrature_ || energyHourglass_)) paddedU_.assign(n, PaddedVec<D>::Zero());
     // The force pass summed from its sources when it has no other pair term
     if (!ganzenmueller_ && !viscosity_ && !separateHourglassGradient_) {
+      // (the stress it is given: forcePass)
       if (quadrature_)
         taylorScatter_ = std::make_unique<InternalForceScatter<D, true>>(
-            reference.neighbours, reverseGradient_, &quadrature_->reverseRows());
+            reference.neighbours, reverseGradient_, &quadrature_->reverseRows(), true);
       else
-        nodalScatter_ = std::make_unique<InternalForceScatter<D, false>>(reference.neighbours,
-                                                                         reverseGradient_, nullptr);
+        nodalScatter_ = std::make_unique<InternalForceScatter<D, false>>(
+            reference.neighbours, reverseGradient_, nullptr, energyHourglass_ != nullptr);
     }
     prefetchGathers_ = gathersFromMemory(gatheredBytesPerParticle() * n);
   }
