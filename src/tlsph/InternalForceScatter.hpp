@@ -17,15 +17,17 @@
 // distributed rank's sources are the particles with a list (its own and its halo, whose S and R
 // the halo exchange brought); targets that are not its own are summed too, and never read.
 //
-// In 3D, when the stress is padded (the quadrature's, or P + P^hg; P alone is sent unpadded),
-// a source's records are stored two pairs interleaved entry by entry (pairs 2b and 2b+1:
-// t_0 t_0' t_1 t_1' t_2 t_2', then T_0 T_0' ... T_5 T_5' with the quadrature), so that with
-// AVX-512 one 512-bit multiply-add serves two pairs: the source's columns duplicated lane by
-// lane (S_0e S_0e S_1e S_1e ...) times one entry of both records (a 128-bit load, repeated),
-// the rows of the two targets' terms side by side. Each lane is the one-pair product's lane,
-// the same multiply-adds in the same order: the same bits. Half the multiply-adds and record
-// loads of pair by pair, for three shuffles per two pairs (the two targets' sums in and out);
-// +3-8 % per step at the defaults, +3-4 % linear/nodal (Zen 5, docs/performance.md).
+// In 3D with AVX-512, when the stress is padded (the quadrature's, or P + P^hg; P alone is
+// sent unpadded), a source's records are stored two pairs interleaved entry by entry (pairs 2b
+// and 2b+1: t_0 t_0' t_1 t_1' t_2 t_2', then T_0 T_0' ... T_5 T_5' with the quadrature), so
+// that one 512-bit multiply-add serves two pairs: the source's columns duplicated lane by lane
+// (S_0e S_0e S_1e S_1e ...) times one entry of both records (a 128-bit load, repeated), the
+// rows of the two targets' terms side by side. Each lane is the one-pair product's lane, the
+// same multiply-adds in the same order: the same bits. Half the multiply-adds and record loads
+// of pair by pair, for three shuffles per two pairs (the two targets' sums in and out); +3-8 %
+// per step at the defaults, +3-4 % linear/nodal (Zen 5, docs/performance.md). Without AVX-512
+// the records stay one after the other: pair by pair, reading them every other entry would
+// only cost (0.91-0.95x measured for the unpadded P that way).
 #pragma once
 
 #include <algorithm>
@@ -62,15 +64,20 @@ class InternalForceScatter {
   using Record = std::conditional_t<Taylor, Eigen::Matrix<double, D + P, 1>, Vec<D>>;
   static constexpr int E = Record::RowsAtCompileTime;  // entries per record
   using RecordPair = std::array<double, 2 * E>;        // two records interleaved
+#if defined(__AVX512F__) && defined(__AVX512DQ__)
+  static constexpr bool kTwoPairsWide = true;  // the 512-bit form below is compiled
+#else
+  static constexpr bool kTwoPairsWide = false;
+#endif
 
   // t: the gather's rows of t_IJ (each target's own list); T: those of T_IJ (Taylor only).
   // Pairs whose target has no list (a distributed rank's halo edge) get zero: such targets
-  // are not the rank's. paddedStress: accumulate() will be given a padded S (3D: the records
-  // are then stored in pairs).
+  // are not the rank's. paddedStress: accumulate() will be given a padded S (3D with AVX-512:
+  // the records are then stored in pairs).
   InternalForceScatter(const NeighbourList& nb, const SharedRows<Vec<D>>& t,
                        const SharedRows<Sym>* T, bool paddedStress)
       : nb_(nb),
-        interleaved_(D == 3 && paddedStress),
+        interleaved_(D == 3 && paddedStress && kTwoPairsWide),
         sums_(static_cast<std::size_t>(nb.particleCount()), PaddedVec<D>::Zero()) {
     PairArray<Record> records(nb.pairCount(), Record::Zero());
     const Index n = nb.particleCount();
@@ -188,8 +195,8 @@ class InternalForceScatter {
     }
   }
 
-  // The records two by two interleaved (3D, S padded). With AVX-512 two pairs per 512-bit
-  // multiply-add; otherwise pair by pair.
+  // The records two by two interleaved (3D, AVX-512, S padded): two pairs per 512-bit
+  // multiply-add. (Pair by pair for an unpadded S, which the constructor's flag rules out.)
   template <class SM>
   void scatterInterleaved(Index j, Index k0, Index k1, const LargeArray<SM>& S,
                           const LargeArray<PaddedSymMatrix>* R) {
