@@ -32,6 +32,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cassert>
 #include <type_traits>
 #include <vector>
 
@@ -163,10 +164,10 @@ class InternalForceScatter {
       ++k0;
     while (neighbour[k1 - 1] >= b)
       --k1;
-    if (interleaved_)
-      scatterInterleaved(j, k0, k1, S, R);
-    else
-      scatterRecords(j, k0, k1, S, R);
+    if constexpr (kTwoPairsWide && SM::RowsAtCompileTime == 4)
+      if (interleaved_) return scatterInterleaved(j, k0, k1, S, R);
+    assert(!interleaved_);  // the constructor's flag: interleaved only for a padded S
+    scatterRecords(j, k0, k1, S, R);
   }
 
   // Pair by pair, each pair's record as it is.
@@ -195,94 +196,72 @@ class InternalForceScatter {
     }
   }
 
-  // The records two by two interleaved (3D, AVX-512, S padded): two pairs per 512-bit
-  // multiply-add. (Pair by pair for an unpadded S, which the constructor's flag rules out.)
+#if defined(__AVX512F__) && defined(__AVX512DQ__)
+  // The records two by two interleaved (3D, S padded): two pairs per 512-bit multiply-add.
   template <class SM>
   void scatterInterleaved(Index j, Index k0, Index k1, const LargeArray<SM>& S,
                           const LargeArray<PaddedSymMatrix>* R) {
-    constexpr int Rows = SM::RowsAtCompileTime;
     const Index* neighbour = nb_.neighbour.data();
     const Index start = nb_.offset[j];
     // entry e of the row's pair m: records[2E (m/2) + 2e + m%2]
     const double* records = recordPairs_.row(j)->data();
     PaddedVec<D>* sums = sums_.data();
-#if defined(__AVX512F__) && defined(__AVX512DQ__)
-    if constexpr (Rows == 4) {
-      // (the masked forms with a full mask: GCC 12 warns on the plain ones, whose pass-through
-      // is an undefined register)
-      auto twice = [](const double* c) {  // c0 c1 c2 c3 c0 c1 c2 c3
-        return _mm512_maskz_broadcast_f64x4(0xff, _mm256_load_pd(c));
-      };
-      auto low = [](__m512d v) {
-        return _mm512_mask_extractf64x4_pd(_mm256_setzero_pd(), 0xf, v, 0);
-      };
-      const __m512i duplicate = _mm512_set_epi64(3, 3, 2, 2, 1, 1, 0, 0);
-      auto columns = [&](const double* c) {  // c0 c0 c1 c1 c2 c2 c3 c3
-        return _mm512_maskz_permutexvar_pd(0xff, duplicate, twice(c));
-      };
-      const double* sj = S[j].data();
-      const __m512d s0 = columns(sj), s1 = columns(sj + 4), s2 = columns(sj + 8);
-      [[maybe_unused]] __m512d r0, r1, r2, r3, r4, r5;
-      if constexpr (Taylor) {
-        const double* rj = (*R)[j].data();
-        r0 = columns(rj), r1 = columns(rj + 4), r2 = columns(rj + 8);
-        r3 = columns(rj + 12), r4 = columns(rj + 16), r5 = columns(rj + 20);
-      }
-      const __m512i interleave = _mm512_set_epi64(11, 3, 10, 2, 9, 1, 8, 0);
-      const __m512i evens = _mm512_set_epi64(7, 5, 3, 1, 6, 4, 2, 0);
-      const __m512i odds = _mm512_set_epi64(6, 4, 2, 0, 7, 5, 3, 1);
-      // the sum of a pair outside [k0, k1) beside one inside (never read)
-      PaddedVec<D> outside = PaddedVec<D>::Zero();
-      const Index m0 = k0 - start;
-      const double* x = records + 2 * E * (m0 / 2);
-      for (Index k = k0 - m0 % 2; k < k1; k += 2, x += 2 * E) {
-        prefetchAhead(x);
-        if constexpr (Taylor) prefetchAhead(x + 8);
-        auto entry = [&](int e) {
-          return _mm512_maskz_broadcast_f64x2(0xff, _mm_loadu_pd(x + 2 * e));
-        };
-        // S_J t_IJ and R_J . T_IJ of both pairs, each lane as the one-pair product's (6.70)
-        __m512d a = _mm512_mul_pd(s0, entry(0));
-        a = _mm512_fmadd_pd(s1, entry(1), a);
-        a = _mm512_fmadd_pd(s2, entry(2), a);
-        [[maybe_unused]] __m512d h;
-        if constexpr (Taylor) {
-          h = _mm512_mul_pd(r0, entry(3));
-          h = _mm512_fmadd_pd(r1, entry(4), h);
-          h = _mm512_fmadd_pd(r2, entry(5), h);
-          h = _mm512_fmadd_pd(r3, entry(6), h);
-          h = _mm512_fmadd_pd(r4, entry(7), h);
-          h = _mm512_fmadd_pd(r5, entry(8), h);
-        }
-        double* first = (k >= k0 ? sums[neighbour[k]] : outside).data();
-        double* second = (k + 1 < k1 ? sums[neighbour[k + 1]] : outside).data();
-        __m512d sum = _mm512_permutex2var_pd(twice(first), interleave, twice(second));
-        sum = _mm512_sub_pd(sum, a);  // the gather's order
-        if constexpr (Taylor) sum = _mm512_sub_pd(sum, h);
-        _mm256_store_pd(first, low(_mm512_maskz_permutexvar_pd(0xff, evens, sum)));
-        _mm256_store_pd(second, low(_mm512_maskz_permutexvar_pd(0xff, odds, sum)));
-      }
-      return;
+    // (the masked forms with a full mask: GCC 12 warns on the plain ones, whose pass-through
+    // is an undefined register)
+    auto twice = [](const double* c) {  // c0 c1 c2 c3 c0 c1 c2 c3
+      return _mm512_maskz_broadcast_f64x4(0xff, _mm256_load_pd(c));
+    };
+    auto low = [](__m512d v) {
+      return _mm512_mask_extractf64x4_pd(_mm256_setzero_pd(), 0xf, v, 0);
+    };
+    const __m512i duplicate = _mm512_set_epi64(3, 3, 2, 2, 1, 1, 0, 0);
+    auto columns = [&](const double* c) {  // c0 c0 c1 c1 c2 c2 c3 c3
+      return _mm512_maskz_permutexvar_pd(0xff, duplicate, twice(c));
+    };
+    const double* sj = S[j].data();
+    const __m512d s0 = columns(sj), s1 = columns(sj + 4), s2 = columns(sj + 8);
+    [[maybe_unused]] __m512d r0, r1, r2, r3, r4, r5;
+    if constexpr (Taylor) {
+      const double* rj = (*R)[j].data();
+      r0 = columns(rj), r1 = columns(rj + 4), r2 = columns(rj + 8);
+      r3 = columns(rj + 12), r4 = columns(rj + 16), r5 = columns(rj + 20);
     }
-#endif
-    SM Sj;
-    Sj = S[j];  // (assigned: see scatterRecords)
-    [[maybe_unused]] PaddedSymMatrix Rj;
-    if constexpr (Taylor) Rj = (*R)[j];
-    for (Index k = k0; k < k1; ++k) {
-      const Index m = k - start;
-      const Eigen::Map<const Record, 0, Eigen::InnerStride<2>> r(records + 2 * E * (m / 2) + m % 2);
-      PaddedVec<D>& target = sums[neighbour[k]];
-      PaddedVec<D> sum = target;
-      // the gather's two subtractions, in its order (6.70; the hyperstress term)
-      sum.template head<Rows>().noalias() -= Sj * r.template head<D>();
+    const __m512i interleave = _mm512_set_epi64(11, 3, 10, 2, 9, 1, 8, 0);
+    const __m512i evens = _mm512_set_epi64(7, 5, 3, 1, 6, 4, 2, 0);
+    const __m512i odds = _mm512_set_epi64(6, 4, 2, 0, 7, 5, 3, 1);
+    // the sum of a pair outside [k0, k1) beside one inside (never read)
+    PaddedVec<D> outside = PaddedVec<D>::Zero();
+    const Index m0 = k0 - start;
+    const double* x = records + 2 * E * (m0 / 2);
+    for (Index k = k0 - m0 % 2; k < k1; k += 2, x += 2 * E) {
+      prefetchAhead(x);
+      if constexpr (Taylor) prefetchAhead(x + 8);
+      auto entry = [&](int e) {
+        return _mm512_maskz_broadcast_f64x2(0xff, _mm_loadu_pd(x + 2 * e));
+      };
+      // S_J t_IJ and R_J . T_IJ of both pairs, each lane as the one-pair product's (6.70)
+      __m512d a = _mm512_mul_pd(s0, entry(0));
+      a = _mm512_fmadd_pd(s1, entry(1), a);
+      a = _mm512_fmadd_pd(s2, entry(2), a);
+      [[maybe_unused]] __m512d h;
       if constexpr (Taylor) {
-        const PaddedVec<D> hyper = Rj * r.template tail<P>();
-        sum.noalias() -= hyper;
+        h = _mm512_mul_pd(r0, entry(3));
+        h = _mm512_fmadd_pd(r1, entry(4), h);
+        h = _mm512_fmadd_pd(r2, entry(5), h);
+        h = _mm512_fmadd_pd(r3, entry(6), h);
+        h = _mm512_fmadd_pd(r4, entry(7), h);
+        h = _mm512_fmadd_pd(r5, entry(8), h);
       }
-      target = sum;
+      double* first = (k >= k0 ? sums[neighbour[k]] : outside).data();
+      double* second = (k + 1 < k1 ? sums[neighbour[k + 1]] : outside).data();
+      __m512d sum = _mm512_permutex2var_pd(twice(first), interleave, twice(second));
+      sum = _mm512_sub_pd(sum, a);  // the gather's order
+      if constexpr (Taylor) sum = _mm512_sub_pd(sum, h);
+      _mm256_store_pd(first, low(_mm512_maskz_permutexvar_pd(0xff, evens, sum)));
+      _mm256_store_pd(second, low(_mm512_maskz_permutexvar_pd(0xff, odds, sum)));
     }
   }
+#endif
 
   // The records of sources' pairs 2b and 2b+1 interleaved entry by entry (an odd row's last
   // record beside zeros), each distinct row of record pairs kept once.

@@ -111,13 +111,13 @@ class TlsphForces {
     if (D == 3 && (quadrature_ || energyHourglass_)) paddedU_.assign(n, PaddedVec<D>::Zero());
     // The force pass summed from its sources when it has no other pair term
     if (!ganzenmueller_ && !viscosity_ && !separateHourglassGradient_) {
-      // (the stress it is given: forcePass)
       if (quadrature_)
         taylorScatter_ = std::make_unique<InternalForceScatter<D, true>>(
-            reference.neighbours, reverseGradient_, &quadrature_->reverseRows(), true);
+            reference.neighbours, reverseGradient_, &quadrature_->reverseRows(),
+            forcePassStressIsPadded());
       else
         nodalScatter_ = std::make_unique<InternalForceScatter<D, false>>(
-            reference.neighbours, reverseGradient_, nullptr, energyHourglass_ != nullptr);
+            reference.neighbours, reverseGradient_, nullptr, forcePassStressIsPadded());
     }
     prefetchGathers_ = gathersFromMemory(gatheredBytesPerParticle() * n);
   }
@@ -634,6 +634,9 @@ class TlsphForces {
   }
   // The stress the force pass sends through the gradient vectors: P (+ P^q), or that plus
   // P^hg (or P^hg alone through the linear vectors), padded but for P alone.
+  bool forcePassStressIsPadded() const {
+    return (energyHourglass_ && !separateHourglassGradient_) || quadrature_;
+  }
   template <bool Taylor, bool Gather>
   void forcePass(const std::vector<Vec<D>>& u, std::vector<Vec<D>>& f, const std::vector<Vec<D>>* v,
                  bool viscous) {
