@@ -362,7 +362,7 @@ class TaylorQuadrature {
     [[gnu::always_inline]] void add(const PaddedVec<D>& uj, const double* c) requires(D == 3) {
       // one load of the record's first eight entries, kept in a register: GCC otherwise folds
       // it into each of the three multiply-adds, three 64-byte loads of which, the records
-      // being 72 B apart, most split across two cache lines (+6-9 % per step, Zen 5)
+      // being 72 B apart, most split across two cache lines (+6-10 % per step, Zen 5)
       __m512d first = _mm512_loadu_pd(c);
       __asm__("" : "+v"(first));
       row0 = _mm512_fmadd_pd(_mm512_sub_pd(_mm512_set1_pd(uj[0]), ui0), first, row0);
