@@ -13,6 +13,7 @@
 #include <cmath>
 #include <iostream>
 #include <memory>
+#include <random>
 #include <vector>
 
 #include "geometry/LocalityOrder.hpp"
@@ -70,7 +71,7 @@ int main(int argc, char** argv) {
 #else
   const int ranks = 1;
 #endif
-  double dx = 0.0125, supportRatio = 2.1, alpha = 10.0, length = 1.0;
+  double dx = 0.0125, supportRatio = 2.1, alpha = 10.0, length = 1.0, jitter = 0.0;
   long steps = 200, particles = 0;
   bool stream = true;
   std::string material = "neo-hookean", correction = "linear", form = "energy",
@@ -88,9 +89,12 @@ int main(int argc, char** argv) {
       "no-stream", "skip measuring the copy bandwidth")(
       "length", po::value(&length)->default_value(length),
       "beam length [m] (cross-section 0.1 x 0.1; weak scaling: length x ranks)")(
-      "correction", po::value(&correction)->default_value(correction),
-      "gradient correction: linear or quadratic")("form", po::value(&form)->default_value(form),
-                                                  "hourglass form: energy or ganzenmueller")(
+      "jitter", po::value(&jitter)->default_value(jitter),
+      "move each particle off the lattice by up to this fraction of dx per axis, below 0.25 "
+      "(1e-6: the lattice's physics with no two neighbourhoods alike to the bit, so no "
+      "per-pair row is shared)")("correction", po::value(&correction)->default_value(correction),
+                                 "gradient correction: linear or quadratic")(
+      "form", po::value(&form)->default_value(form), "hourglass form: energy or ganzenmueller")(
       "quadrature", po::value(&quadrature)->default_value(quadrature),
       "strain-energy quadrature: nodal or taylor (taylor needs the quadratic correction)");
   po::variables_map vm;
@@ -106,6 +110,12 @@ int main(int argc, char** argv) {
 
   if (particles > 0) dx = 0.1 / std::max(1L, std::lround(std::cbrt(particles / (10.0 * length))));
   stream = !vm.count("no-stream");
+  if (!(jitter >= 0.0 && jitter < 0.25)) {
+    std::cerr << "tlsph_bench: --jitter " << jitter
+              << ": expected a fraction of dx in [0, 0.25) (larger moves a particle across the "
+                 "clamp's plane or onto a neighbour)\n";
+    return 2;
+  }
 
   Scene<3> scene;
   scene.materials.push_back(
@@ -126,6 +136,13 @@ int main(int argc, char** argv) {
   auto lattice =
       cellCentredLattice<3>(Vec3(-ghostLayers * dx, -0.05, -0.05), {ghostLayers + nx, ny, ny}, dx);
   sortForLocality<3>(lattice);
+  if (jitter > 0.0) {  // a fixed seed: every run places the particles alike
+    std::mt19937_64 random(12);
+    std::uniform_real_distribution<double> offset(-jitter * dx, jitter * dx);
+    for (auto& X : lattice)
+      for (int d = 0; d < 3; ++d)
+        X[d] += offset(random);
+  }
   Index tip = 0;  // the body's particle at the largest x, lowest y and z
   for (const auto& X : lattice)
     if (X.x() > 0.0) {
@@ -146,7 +163,9 @@ int main(int argc, char** argv) {
   std::cout << "particles " << scene.particles.size() << " (" << nx * ny * ny << " body), "
             << "mean neighbours " << double(nb.pairCount()) / nb.particleCount() << ", threads "
             << omp_get_max_threads() << ", dt " << solver.timeStep() << ", " << correction
-            << " correction, " << quadrature << " quadrature, hourglass " << form << "\n";
+            << " correction, " << quadrature << " quadrature, hourglass " << form;
+  if (jitter > 0.0) std::cout << ", jitter " << jitter << " dx";
+  std::cout << "\n";
   if (ranks > 1)
     std::cout << "ranks " << ranks << ", partition " << solver.partition().method << ", halo "
               << solver.partition().halo << " particles in all, imbalance "
@@ -179,6 +198,11 @@ int main(int argc, char** argv) {
   solver.synchronize();  // (distributed: the tip's displacement from its rank)
   std::cout << "steps " << steps << ", wall " << seconds << " s, particle-steps/s " << rate
             << ", tip u_z " << scene.particles.displacement[tip].z() << "\n";
+  if (!std::isfinite(scene.particles.displacement[tip].z())) {
+    std::cerr << "tlsph_bench: the run blew up (tip displacement not finite); its rate is not "
+                 "a measurement\n";
+    return 1;
+  }
   // The roofline: what the force passes must move per particle-step (TlsphForces::traffic),
   // against what a plain copy moves on this machine with the same threads.
   const auto traffic = solver.forces().traffic();
