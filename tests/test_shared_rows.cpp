@@ -2,11 +2,13 @@
 // back exactly its own row, rows are shared only when equal bit for bit, and the operators that
 // keep their per-pair data this way (the Taylor fit and its reverse) still hold the relations
 // the force's exactness rests on (g_IJ of the fit = the corrected gradient vectors,
-// T_IJ = (V_J / V_I) S_JI, bit for bit).
+// T_IJ = (V_J / V_I) S_JI, bit for bit). streams(): whether a pass over the particles in order
+// reads the rows front to back, where the pair loops prefetch ahead.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cstring>
+#include <random>
 #include <vector>
 
 #include "TestSupport.hpp"
@@ -67,6 +69,9 @@ TEST(SharedRows, SharesOnlyRowsEqualBitForBit) {
   EXPECT_NE(rows.row(0), rows.row(3));  // -0.0 is not merged with 0.0
   EXPECT_NE(rows.row(0), rows.row(4));
   expectRowsReadBack(nb, full, rows);
+  // read in particle order the rows jump back three times in five (to row 0, past row 0 to
+  // row 3, to row 0): not a forward stream, no prefetch
+  EXPECT_FALSE(rows.streams());
 }
 
 TEST(SharedRows, EmptyListsAndVectorValues) {
@@ -91,16 +96,19 @@ TEST(SharedRows, CopiesOnlyWhenItPays) {
   EXPECT_EQ(inPlace.storedValues(), 6u);  // what the loops read
   for (Index i = 0; i < 3; ++i)
     EXPECT_EQ(inPlace.row(i), twoOfThree.data() + nb.offset[i]);
+  EXPECT_TRUE(inPlace.streams());  // every row where the previous one ended
   const SharedRows<double> handedOver(nb, PairArray<double>(twoOfThree));
   EXPECT_FALSE(handedOver.aliases());
   EXPECT_EQ(handedOver.storedValues(), 4u);
   expectRowsReadBack(nb, twoOfThree, handedOver);
+  EXPECT_TRUE(handedOver.streams());  // one step of two forward (row 2 after row 1): half
   const PairArray<double> distinct{1.0, 2.0, 3.0, 4.0, 5.0, 6.0};
   const SharedRows<double> whole(nb, PairArray<double>(distinct));
   EXPECT_FALSE(whole.aliases());
   EXPECT_EQ(whole.distinctRows(), 3u);
   EXPECT_EQ(whole.storedValues(), 6u);
   expectRowsReadBack(nb, distinct, whole);
+  EXPECT_TRUE(whole.streams());
 }
 
 // On a lattice, whose coordinates are exact on one binary grid (LatticeGrid.hpp) whatever dx and
@@ -121,6 +129,28 @@ TEST(SharedRows, LatticeRowsAreSharedAndReadBack) {
   EXPECT_FALSE(g.aliases());
   expectRowsReadBack(nb, ref.correctedGradient, g);
   expectRowsReadBack(nb, ref.reverseGradient, t);
+  // most particles read a row read before: the pair loops leave out the line-ahead prefetch
+  EXPECT_FALSE(g.streams());
+  EXPECT_FALSE(t.streams());
+}
+
+// The same block moved off the lattice by a millionth of dx: no two rows are equal, each
+// particle's row follows the previous one's and the loops prefetch ahead; the rows read back.
+TEST(SharedRows, RowsOffTheLatticeStreamForward) {
+  const double dx = 0.01;
+  std::mt19937 rng(7);
+  const auto X = perturbedBlock<3>({20, 8, 8}, dx, 1e-6, rng);
+  const std::vector<double> volume(X.size(), dx * dx * dx);
+  const auto ref = buildReferenceConfiguration<3>(
+      X, volume, Kernel<3>(KernelType::WendlandC2, 2.1 * dx), {}, GradientCorrection::Quadratic);
+  const auto& nb = ref.neighbours;
+  const SharedRows<Vec3> g(nb, ref.correctedGradient);
+  EXPECT_EQ(g.distinctRows(), std::size_t(nb.particleCount()));
+  EXPECT_TRUE(g.aliases());
+  EXPECT_TRUE(g.streams());
+  expectRowsReadBack(nb, ref.correctedGradient, g);
+  const SharedRows<Vec3> handedOver(nb, PairArray<Vec3>(ref.correctedGradient));
+  EXPECT_TRUE(handedOver.streams());
 }
 
 // The Taylor quadrature keeps its fit and its reverse as shared rows: the fit's g_IJ part is

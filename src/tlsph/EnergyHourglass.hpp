@@ -61,6 +61,17 @@ class EnergyHourglass {
   template <bool Gradient = false, bool Gather = false, class U, class FM, class PM, class SM>
   void evaluate(std::span<const U> u, std::span<const FM> F, const PM* P, std::span<SM> stress,
                 const std::vector<Index>* particles = nullptr, MeetInTheMiddle* split = nullptr) {
+    // the rows' line ahead only where they stream (SharedRows::streams): a branch per pair
+    // measured as slow as the prefetch itself, so two loops
+    if (separation_.streams() || c_.streams())
+      evaluateRows<Gradient, Gather, true>(u, F, P, stress, particles, split);
+    else
+      evaluateRows<Gradient, Gather, false>(u, F, P, stress, particles, split);
+  }
+
+  template <bool Gradient, bool Gather, bool Ahead, class U, class FM, class PM, class SM>
+  void evaluateRows(std::span<const U> u, std::span<const FM> F, const PM* P, std::span<SM> stress,
+                    const std::vector<Index>* particles, MeetInTheMiddle* split) {
     constexpr int R = U::RowsAtCompileTime;  // D, or 4 when padded
     using Row = Eigen::Matrix<double, R, 1>;
     using Moment = Eigen::Matrix<double, R, D>;
@@ -81,8 +92,10 @@ class EnergyHourglass {
           const double* c = c_.row(i);
           for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k, ++X, ++c) {
             const Index j = nb.neighbour[k];
-            prefetchAhead(X);
-            prefetchAhead(c);
+            if constexpr (Ahead) {
+              prefetchAhead(X);
+              prefetchAhead(c);
+            }
             if constexpr (Gather) prefetchGather(F.data(), j);
             const Vec<D> Xij = X->template head<D>();
             const Row HjX = Gradient ? Row(F[j] * Xij) : Row(F[j] * Xij - X->template head<R>());

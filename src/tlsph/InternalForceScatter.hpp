@@ -165,13 +165,18 @@ class InternalForceScatter {
     while (neighbour[k1 - 1] >= b)
       --k1;
     if constexpr (kTwoPairsWide && SM::RowsAtCompileTime == 4)
-      if (interleaved_) return scatterInterleaved(j, k0, k1, S, R);
+      if (interleaved_)
+        return recordPairs_.streams() ? scatterInterleaved<true>(j, k0, k1, S, R)
+                                      : scatterInterleaved<false>(j, k0, k1, S, R);
     assert(!interleaved_);  // the constructor's flag: interleaved only for a padded S
-    scatterRecords(j, k0, k1, S, R);
+    // the rows' line ahead only where they stream (SharedRows::streams; a branch per pair
+    // measured as slow as the prefetch itself)
+    records_.streams() ? scatterRecords<true>(j, k0, k1, S, R)
+                       : scatterRecords<false>(j, k0, k1, S, R);
   }
 
   // Pair by pair, each pair's record as it is.
-  template <class SM>
+  template <bool Ahead, class SM>
   void scatterRecords(Index j, Index k0, Index k1, const LargeArray<SM>& S,
                       const LargeArray<PaddedSymMatrix>* R) {
     constexpr int Rows = SM::RowsAtCompileTime;
@@ -183,7 +188,7 @@ class InternalForceScatter {
     const Record* record = records_.row(j) + (k0 - nb_.offset[j]);
     PaddedVec<D>* sums = sums_.data();  // a local: the stores below cannot move it
     for (Index k = k0; k < k1; ++k, ++record) {
-      prefetchAhead(record);
+      if constexpr (Ahead) prefetchAhead(record);
       PaddedVec<D>& target = sums[neighbour[k]];
       PaddedVec<D> sum = target;
       // the gather's two subtractions, in its order (6.70; the hyperstress term)
@@ -198,7 +203,7 @@ class InternalForceScatter {
 
 #if defined(__AVX512F__) && defined(__AVX512DQ__)
   // The records two by two interleaved (3D, S padded): two pairs per 512-bit multiply-add.
-  template <class SM>
+  template <bool Ahead, class SM>
   void scatterInterleaved(Index j, Index k0, Index k1, const LargeArray<SM>& S,
                           const LargeArray<PaddedSymMatrix>* R) {
     const Index* neighbour = nb_.neighbour.data();
@@ -234,8 +239,10 @@ class InternalForceScatter {
     const Index m0 = k0 - start;
     const double* x = records + 2 * E * (m0 / 2);
     for (Index k = k0 - m0 % 2; k < k1; k += 2, x += 2 * E) {
-      prefetchAhead(x);
-      if constexpr (Taylor) prefetchAhead(x + 8);
+      if constexpr (Ahead) {
+        prefetchAhead(x);
+        if constexpr (Taylor) prefetchAhead(x + 8);
+      }
       auto entry = [&](int e) {
         return _mm512_maskz_broadcast_f64x2(0xff, _mm_loadu_pd(x + 2 * e));
       };

@@ -7,7 +7,9 @@
 // once per record, measured +34-46 % per step at 41,728 particles and +0.5-14 % at 5,312 (both
 // corrections, 1 and 2 threads, Intel Xeon model 167), with a broad optimum at 1.5-2 KB ahead
 // (tried 0.5-6 KB): about one particle's row of the widest (72 B) record. docs/performance.md
-// has the tables.
+// has the tables. That was before rows were shared (SharedRows.hpp): a pass now asks only where
+// its rows stream (SharedRows::streams); the beam's shared rows, read mostly from cache, ran
+// 1-4 % faster without it, rows off the lattice 20-30 % slower (Zen 5).
 #pragma once
 
 #include <cstddef>

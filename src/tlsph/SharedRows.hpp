@@ -41,6 +41,7 @@ class SharedRows {
       keep(nb, full, p);
     else
       alias(nb, full, p);
+    streams_ = readForward(nb);
   }
   // The same for an array handed over: the distinct rows if any row repeats, else full itself.
   SharedRows(const NeighbourList& nb, PairArray<T>&& full) {
@@ -52,6 +53,7 @@ class SharedRows {
       alias(nb, values_, p);
       alias_ = nullptr;
     }
+    streams_ = readForward(nb);
   }
 
   // Particle i's row: the value of its m-th pair (in its neighbour list's order) is row(i)[m].
@@ -66,6 +68,13 @@ class SharedRows {
   double storedBytes() const { return double(storedValues()) * sizeof(T); }
   // True when the rows are those of the array given, not a copy.
   bool aliases() const { return alias_ != nullptr; }
+  // True when a pass over the particles in order reads the values front to back: at least half
+  // the particles' rows start where the previous particle's ended (all of them when no row is
+  // shared). Only then does asking for the line ahead (prefetchAhead) pay: shared rows jump
+  // back to a row read before, mostly still in cache, and the line ahead is one no particle
+  // needs soon (measured: +34-46 % per step with unshared rows, 1-3 % slower with the beam's
+  // shared ones; docs/performance.md).
+  bool streams() const { return streams_; }
 
  private:
   struct Plan {
@@ -111,6 +120,14 @@ class SharedRows {
     alias_ = &full;
   }
 
+  bool readForward(const NeighbourList& nb) const {
+    const Index n = static_cast<Index>(start_.size());
+    Index forward = 0;
+    for (Index i = 1; i < n; ++i)
+      forward += start_[i] == start_[i - 1] + nb.count(i - 1);
+    return 2 * forward >= n - 1;
+  }
+
   static std::string_view rowBytes(const NeighbourList& nb, const PairArray<T>& full, Index i) {
     return {reinterpret_cast<const char*>(full.data() + nb.offset[i]),
             sizeof(T) * static_cast<std::size_t>(nb.count(i))};
@@ -120,6 +137,7 @@ class SharedRows {
   const PairArray<T>* alias_ = nullptr;  // or the rows of this array
   std::vector<Index> start_;             // particle i's row starts at start_[i]
   std::size_t rows_ = 0;                 // distinct rows
+  bool streams_ = true;                  // see streams()
 };
 
 }  // namespace tlsph

@@ -100,8 +100,9 @@ class TaylorQuadrature {
       row.setZero();
     const Vec<D> ui = u[i];
     const Fit* fit = fit_.row(i);
+    const bool ahead = fit_.streams();
     for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k, ++fit) {
-      prefetchAhead(fit);
+      if (ahead) prefetchAhead(fit);
       const Vec<D> du = u[nb.neighbour[k]] - ui;
       const Fit& c = *fit;
       for (int a = 0; a < D; ++a)
@@ -141,7 +142,7 @@ class TaylorQuadrature {
   const Sym* reverseRow(Index i) const { return reverse_.row(i); }
   template <bool Gather = false>
   PaddedVec<D> hyperForcePair(const Sym* T, Index j) const {
-    prefetchAhead(T);
+    if (reverse_.streams()) prefetchAhead(T);
     if constexpr (Gather) prefetchGather(R_.data(), j);
     return R_[j] * *T;
   }
@@ -230,13 +231,15 @@ class TaylorQuadrature {
   using FitSum = PaddedMat<D, D + P>;
   // Written into out from a local (returned by value, the 288-byte result was zeroed with a
   // memset call and copied with a memcpy call per particle).
+  // Ahead: prefetch the fit's line ahead (only where its rows stream, SharedRows::streams).
+  template <bool Ahead = true>
   void paddedGradients(Index i, std::span<const PaddedVec<D>> u, FitSum& out) const {
     const auto& nb = ref_.neighbours;
     FitSum M = FitSum::Zero();  // a local: GCC keeps it in registers through the loop
     const PaddedVec<D> ui = u[i];
     const Fit* fit = fit_.row(i);
     for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k, ++fit) {
-      prefetchAhead(fit);
+      if constexpr (Ahead) prefetchAhead(fit);
       const PaddedVec<D> du = u[nb.neighbour[k]] - ui;
       const Fit& c = *fit;
 #pragma GCC unroll 9
@@ -251,6 +254,7 @@ class TaylorQuadrature {
   // multiply-adds; held as three 8-wide rows (du_a [g_IJ, S_IJ] without its last entry) and one
   // padded column (du S_IJ's last entry), two particles' eight chains keep both 512-bit FMA
   // pipes busy (issue 12). Without AVX-512: paddedGradients twice.
+  template <bool Ahead = true>
   void paddedGradients(Index i0, Index i1, std::span<const PaddedVec<D>> u, FitSum& out0,
                        FitSum& out1) const {
 #if defined(__AVX512F__)
@@ -264,17 +268,19 @@ class TaylorQuadrature {
       const Index end0 = nb.offset[i0 + 1], end1 = nb.offset[i1 + 1];
       for (const Index both = k0 + std::min(end0 - k0, end1 - k1); k0 < both;
            ++k0, ++k1, fit0 += D + P, fit1 += D + P) {
-        prefetchAhead(fit0);
-        prefetchAhead(fit1);
+        if constexpr (Ahead) {
+          prefetchAhead(fit0);
+          prefetchAhead(fit1);
+        }
         s0.add(u[j[k0]], fit0);
         s1.add(u[j[k1]], fit1);
       }
       for (; k0 < end0; ++k0, fit0 += D + P) {
-        prefetchAhead(fit0);
+        if constexpr (Ahead) prefetchAhead(fit0);
         s0.add(u[j[k0]], fit0);
       }
       for (; k1 < end1; ++k1, fit1 += D + P) {
-        prefetchAhead(fit1);
+        if constexpr (Ahead) prefetchAhead(fit1);
         s1.add(u[j[k1]], fit1);
       }
       s0.store(out0);
@@ -282,8 +288,8 @@ class TaylorQuadrature {
       return;
     }
 #endif
-    paddedGradients(i0, u, out0);
-    paddedGradients(i1, u, out1);
+    paddedGradients<Ahead>(i0, u, out0);
+    paddedGradients<Ahead>(i1, u, out1);
   }
 
   // stress = Pm + P^q_I padded (Pm the material's P), keeping R_I, from F and paddedGradients'

@@ -405,8 +405,9 @@ class TlsphForces {
     const Vec<D> ui = u[i];
     Mat<D> gradU = Mat<D>::Zero();
     const Vec<D>* g = gradients.row(i);
+    const bool ahead = gradients.streams();  // SharedRows::streams
     for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k, ++g) {
-      prefetchAhead(g);
+      if (ahead) prefetchAhead(g);
       gradU.noalias() += (u[nb.neighbour[k]] - ui) * g->transpose();
     }
     return Mat<D>::Identity() + gradU;
@@ -455,6 +456,9 @@ class TlsphForces {
     // P + P^q where the penalty adds P^hg in place, else its own array
     [[maybe_unused]] auto& taylorStress = penaltyReadsF() ? stress_ : quadratureStress_;
     constexpr Index kFitBatch = D == 3 && (Taylor || PaddedF) ? 2 : 1;
+    // the fit's line ahead only where its rows stream (SharedRows::streams; a branch per pair
+    // measured as slow as the prefetch itself)
+    [[maybe_unused]] const bool aheadFit = Taylor && q->fitRows().streams();
     split_.reset(count);
 #pragma omp parallel
     {
@@ -465,8 +469,12 @@ class TlsphForces {
           [[maybe_unused]] typename TaylorQuadrature<D>::FitSum Ms[kFitBatch];  // [grad u | Gs]
           [[maybe_unused]] PaddedMat<D> gradUs[kFitBatch];  // 3D nodal: grad u padded
           if constexpr (Taylor && D == 3) {
-            if (p0 + 1 < b)
-              q->paddedGradients(group[p0], group[p0 + 1], paddedU_, Ms[0], Ms[kFitBatch - 1]);
+            if (p0 + 1 < b && aheadFit)
+              q->template paddedGradients<true>(group[p0], group[p0 + 1], paddedU_, Ms[0],
+                                                Ms[kFitBatch - 1]);
+            else if (p0 + 1 < b)
+              q->template paddedGradients<false>(group[p0], group[p0 + 1], paddedU_, Ms[0],
+                                                 Ms[kFitBatch - 1]);
             else
               q->paddedGradients(group[p0], paddedU_, Ms[0]);
           } else if constexpr (PaddedF) {
@@ -498,8 +506,9 @@ class TlsphForces {
                 const Vec<D> ui = u[i];
                 gradU.setZero();
                 const Vec<D>* g = correctedGradient_.row(i);
+                const bool ahead = correctedGradient_.streams();
                 for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k, ++g) {
-                  prefetchAhead(g);
+                  if (ahead) prefetchAhead(g);
                   gradU.noalias() += (u[nb.neighbour[k]] - ui) * g->transpose();
                 }
               }
@@ -547,14 +556,15 @@ class TlsphForces {
     const Vec<D>* g1 = correctedGradient_.row(i1);
     Index k0 = offset[i0], k1 = offset[i1];
     const Index end0 = offset[i0 + 1], end1 = offset[i1 + 1];
+    const bool ahead = correctedGradient_.streams();
     for (const Index both = k0 + std::min(end0 - k0, end1 - k1); k0 < both; ++k0, ++k1) {
-      addPaddedPair(sum0, ui0, k0, g0++);
-      addPaddedPair(sum1, ui1, k1, g1++);
+      addPaddedPair(sum0, ui0, k0, g0++, ahead);
+      addPaddedPair(sum1, ui1, k1, g1++, ahead);
     }
     for (; k0 < end0; ++k0)
-      addPaddedPair(sum0, ui0, k0, g0++);
+      addPaddedPair(sum0, ui0, k0, g0++, ahead);
     for (; k1 < end1; ++k1)
-      addPaddedPair(sum1, ui1, k1, g1++);
+      addPaddedPair(sum1, ui1, k1, g1++, ahead);
     gradU0 = sum0;
     gradU1 = sum1;
   }
@@ -563,14 +573,16 @@ class TlsphForces {
     const PaddedVec<D> ui = paddedU_[i];
     PaddedMat<D> sum = PaddedMat<D>::Zero();
     const Vec<D>* g = correctedGradient_.row(i);
+    const bool ahead = correctedGradient_.streams();
     for (Index k = ref_.neighbours.offset[i]; k < ref_.neighbours.offset[i + 1]; ++k)
-      addPaddedPair(sum, ui, k, g++);
+      addPaddedPair(sum, ui, k, g++, ahead);
     gradU = sum;
   }
-  // Pair k's term (u_J - u_I) (x) g_IJ of grad u, padded, g its gradient vector.
+  // Pair k's term (u_J - u_I) (x) g_IJ of grad u, padded, g its gradient vector (ahead: the
+  // rows stream, SharedRows::streams).
   [[gnu::always_inline]] void addPaddedPair(PaddedMat<D>& sum, const PaddedVec<D>& ui, Index k,
-                                            const Vec<D>* g) const {
-    prefetchAhead(g);
+                                            const Vec<D>* g, bool ahead) const {
+    if (ahead) prefetchAhead(g);
     const PaddedVec<D> du = paddedU_[ref_.neighbours.neighbour[k]] - ui;
     for (int m = 0; m < D; ++m)
       sum.col(m).noalias() += du * (*g)[m];
@@ -681,6 +693,8 @@ class TlsphForces {
     const Index* owned = comm_ ? owned_.data() : nullptr;
     const LargeArray<Mat<D>>& Fh = separateHourglassGradient_ ? hourglassF_ : F_;
     [[maybe_unused]] const TaylorQuadrature<D>* q = quadrature_.get();
+    const bool aheadT = reverseGradient_.streams();  // SharedRows::streams
+    [[maybe_unused]] const bool aheadLinear = SeparateHourglassStress && linearReverse_.streams();
     split_.reset(count);
 #pragma omp parallel
     {
@@ -702,11 +716,11 @@ class TlsphForces {
           [[maybe_unused]] const auto* T = Taylor ? q->reverseRow(i) : nullptr;
           for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k, ++t) {
             const Index j = nb.neighbour[k];
-            prefetchAhead(t);
+            if (aheadT) prefetchAhead(t);
             if constexpr (Gather) prefetchGather(S.data(), j);
             internal.template head<R>().noalias() -= S[j] * *t;
             if constexpr (SeparateHourglassStress) {
-              prefetchAhead(tLinear);
+              if (aheadLinear) prefetchAhead(tLinear);
               internal.noalias() -= stress_[j] * *tLinear++;
             }
             if constexpr (Taylor) internal.noalias() -= q->template hyperForcePair<Gather>(T++, j);
