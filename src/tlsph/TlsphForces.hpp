@@ -475,8 +475,10 @@ class TlsphForces {
             else if (p0 + 1 < b)
               q->template paddedGradients<false>(group[p0], group[p0 + 1], paddedU_, Ms[0],
                                                  Ms[kFitBatch - 1]);
+            else if (aheadFit)
+              q->template paddedGradients<true>(group[p0], paddedU_, Ms[0]);
             else
-              q->paddedGradients(group[p0], paddedU_, Ms[0]);
+              q->template paddedGradients<false>(group[p0], paddedU_, Ms[0]);
           } else if constexpr (PaddedF) {
             if (p0 + 1 < b)
               paddedGradU(group[p0], group[p0 + 1], gradUs[0], gradUs[kFitBatch - 1]);
