@@ -138,11 +138,12 @@ class TaylorQuadrature {
   PaddedVec<D> hyperForceOwn(Index i) const { return R_[i] * sum_[i]; }
   // Every particle's hyperstress R_I (symmetric storage, padded), as the force pass reads it.
   const LargeArray<PaddedSymMatrix>& hyperstresses() const { return R_; }
-  // Particle i's row of T_IJ (T[m] for its m-th pair), and one pair's term R_J . T_IJ.
+  // Particle i's row of T_IJ (T[m] for its m-th pair), and one pair's term R_J . T_IJ;
+  // ahead: prefetch T's line ahead (the caller's reverseRows().streams(), read once per pass).
   const Sym* reverseRow(Index i) const { return reverse_.row(i); }
   template <bool Gather = false>
-  PaddedVec<D> hyperForcePair(const Sym* T, Index j) const {
-    if (reverse_.streams()) prefetchAhead(T);
+  PaddedVec<D> hyperForcePair(const Sym* T, Index j, bool ahead) const {
+    if (ahead) prefetchAhead(T);
     if constexpr (Gather) prefetchGather(R_.data(), j);
     return R_[j] * *T;
   }

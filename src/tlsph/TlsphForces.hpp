@@ -469,16 +469,15 @@ class TlsphForces {
           [[maybe_unused]] typename TaylorQuadrature<D>::FitSum Ms[kFitBatch];  // [grad u | Gs]
           [[maybe_unused]] PaddedMat<D> gradUs[kFitBatch];  // 3D nodal: grad u padded
           if constexpr (Taylor && D == 3) {
-            if (p0 + 1 < b && aheadFit)
-              q->template paddedGradients<true>(group[p0], group[p0 + 1], paddedU_, Ms[0],
-                                                Ms[kFitBatch - 1]);
-            else if (p0 + 1 < b)
-              q->template paddedGradients<false>(group[p0], group[p0 + 1], paddedU_, Ms[0],
-                                                 Ms[kFitBatch - 1]);
-            else if (aheadFit)
-              q->template paddedGradients<true>(group[p0], paddedU_, Ms[0]);
-            else
-              q->template paddedGradients<false>(group[p0], paddedU_, Ms[0]);
+            // two particles' sums, or the chunk's odd last one's
+            auto sums = [&]<bool Ahead>(std::bool_constant<Ahead>) {
+              if (p0 + 1 < b)
+                q->template paddedGradients<Ahead>(group[p0], group[p0 + 1], paddedU_, Ms[0],
+                                                   Ms[kFitBatch - 1]);
+              else
+                q->template paddedGradients<Ahead>(group[p0], paddedU_, Ms[0]);
+            };
+            aheadFit ? sums(std::true_type{}) : sums(std::false_type{});
           } else if constexpr (PaddedF) {
             if (p0 + 1 < b)
               paddedGradU(group[p0], group[p0 + 1], gradUs[0], gradUs[kFitBatch - 1]);
@@ -697,6 +696,7 @@ class TlsphForces {
     [[maybe_unused]] const TaylorQuadrature<D>* q = quadrature_.get();
     const bool aheadT = reverseGradient_.streams();  // SharedRows::streams
     [[maybe_unused]] const bool aheadLinear = SeparateHourglassStress && linearReverse_.streams();
+    [[maybe_unused]] const bool aheadTaylor = Taylor && q->reverseRows().streams();
     split_.reset(count);
 #pragma omp parallel
     {
@@ -725,7 +725,8 @@ class TlsphForces {
               if (aheadLinear) prefetchAhead(tLinear);
               internal.noalias() -= stress_[j] * *tLinear++;
             }
-            if constexpr (Taylor) internal.noalias() -= q->template hyperForcePair<Gather>(T++, j);
+            if constexpr (Taylor)
+              internal.noalias() -= q->template hyperForcePair<Gather>(T++, j, aheadTaylor);
             if constexpr (Ganzenmueller || Viscous) {
               prefetchAhead(&ref_.separation[k]);
               const Vec<D>& Xij = ref_.separation[k];
