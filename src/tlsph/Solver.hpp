@@ -233,6 +233,9 @@ class Solver {
     auto& p = scene_.particles;
     const double halfDt = 0.5 * dt_;
     const double c = scene_.damping.viscous;
+    // Without viscous damping its terms are left out: they divide by 1 and add zeros, which
+    // leaves every bit as it was, and divisions are the kicks' slowest instructions (issue 12).
+    const bool damped = c != 0.0;
     // This rank's particles (all of them in a serial run).
     const Index nFree = static_cast<Index>(ownFree_.size());
     // Work is integrated for the non-conservative terms only: the textbook hourglass force
@@ -249,7 +252,7 @@ class Solver {
       p.velocity[i] += halfDt * (totalForce(i) / p.mass[i] - c * p.velocity[i]);
       const Vec<D> du = dt_ * p.velocity[i];
       p.displacement[i] += du;
-      w[2] += c * p.mass[i] * p.velocity[i].dot(du);
+      if (damped) w[2] += c * p.mass[i] * p.velocity[i].dot(du);
       if (hasExternal_) w[1] += 0.5 * external_[i].dot(du);
       if (hourglass) w[0] += 0.5 * forces_.hourglassForce()[i].dot(du);
       if (viscous) w[2] -= 0.5 * forces_.viscousForce()[i].dot(du);
@@ -295,7 +298,8 @@ class Solver {
       if (hourglass) w[0] += 0.5 * forces_.hourglassForce()[i].dot(du);
       if (viscous) w[2] -= 0.5 * forces_.viscousForce()[i].dot(du);
       // Viscous damping taken implicitly in the second kick: stable for any c.
-      p.velocity[i] = (p.velocity[i] + halfDt * totalForce(i) / p.mass[i]) / (1.0 + c * halfDt);
+      const Vec<D> v = p.velocity[i] + halfDt * totalForce(i) / p.mass[i];
+      p.velocity[i] = damped ? Vec<D>(v / (1.0 + c * halfDt)) : v;
       w[3] += 0.5 * p.mass[i] * p.velocity[i].squaredNorm();
     });
     hourglassWork += kick2[0];
