@@ -233,8 +233,10 @@ class Solver {
     auto& p = scene_.particles;
     const double halfDt = 0.5 * dt_;
     const double c = scene_.damping.viscous;
-    // Without viscous damping its terms are left out: they divide by 1 and add zeros, which
-    // leaves every bit as it was, and divisions are the kicks' slowest instructions (issue 12).
+    // Without viscous damping the second kick's division by 1 + c dt/2 and the damping work
+    // are left out: they divide by 1 and add zeros, so every bit stays, and divisions are the
+    // kicks' slowest instructions (issue 12). The first kick's c v stays: subtracting -0 could
+    // turn a -0 velocity into +0.
     const bool damped = c != 0.0;
     // This rank's particles (all of them in a serial run).
     const Index nFree = static_cast<Index>(ownFree_.size());
