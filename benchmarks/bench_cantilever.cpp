@@ -71,7 +71,8 @@ int main(int argc, char** argv) {
 #else
   const int ranks = 1;
 #endif
-  double dx = 0.0125, supportRatio = 2.1, alpha = 10.0, length = 1.0, jitter = 0.0;
+  double dx = 0.0125, supportRatio = 2.1, alpha = 10.0, length = 1.0, jitter = 0.0,
+         cfl = kDefaultCfl;
   long steps = 200, particles = 0;
   bool stream = true;
   std::string material = "neo-hookean", correction = "linear", form = "energy",
@@ -96,7 +97,9 @@ int main(int argc, char** argv) {
                                  "gradient correction: linear or quadratic")(
       "form", po::value(&form)->default_value(form), "hourglass form: energy or ganzenmueller")(
       "quadrature", po::value(&quadrature)->default_value(quadrature),
-      "strain-energy quadrature: nodal or taylor (taylor needs the quadratic correction)");
+      "strain-energy quadrature: nodal or taylor (taylor needs the quadratic correction)")(
+      "cfl", po::value(&cfl)->default_value(cfl),
+      "C_cfl of the wave-speed time step (a scene's [time] cfl)");
   po::variables_map vm;
   po::store(po::parse_command_line(argc, argv, options), vm);
   po::notify(vm);
@@ -114,6 +117,10 @@ int main(int argc, char** argv) {
     std::cerr << "tlsph_bench: --jitter " << jitter
               << ": expected a fraction of dx in [0, 0.25) (larger moves a particle across the "
                  "clamp's plane or onto a neighbour)\n";
+    return 2;
+  }
+  if (!(cfl > 0.0)) {
+    std::cerr << "tlsph_bench: --cfl " << cfl << ": expected a positive C_cfl\n";
     return 2;
   }
 
@@ -155,9 +162,9 @@ int main(int argc, char** argv) {
     if (X.x() < 0.0) scene.particles.add(X, V, 1000.0 * V, 0, Motion::Prescribed);
 
 #ifdef TLSPH_HAVE_MPI
-  Solver<3> solver(scene, {}, comm.get());
+  Solver<3> solver(scene, {cfl}, comm.get());
 #else
-  Solver<3> solver(scene);
+  Solver<3> solver(scene, {cfl});
 #endif
   const auto& nb = solver.reference().neighbours;
   std::cout << "particles " << scene.particles.size() << " (" << nx * ny * ny << " body), "
