@@ -382,7 +382,7 @@ TEST(Multigrid, GivesBitwiseEqualResultsOnAnyThreadCount) {
   // The diagonal blocks, the Lanczos bound and the interpolations are all summed in a fixed
   // order: the same iterations and the same bits on 1 and 3 threads.
   std::vector<Result<3>> results;
-  for (int threads : {1, 3}) {
+  for ([[maybe_unused]] int threads : {1, 3}) {
 #ifdef _OPENMP
     omp_set_num_threads(threads);
 #endif

@@ -117,7 +117,7 @@ class TaylorQuadrature {
   Mat<D> stressAt(Index i, const Mat<D>& F, const SymMatrix& Gs) requires(D == 2) {
     if (weight_[i] == 0.0) return Mat<D>::Zero();  // R_i stays zero
     G_[i] = Gs;
-    if (smallStrain_[i]) return smallStrainHyperstress(i, Gs);
+    if (smallStrain_[i]) return smallStrainHyperstress(i, Gs).template topRows<D>();
     const Gradients A = unpack(F.transpose() * Gs);  // F^T G_a
     const Gradients G = unpack(Gs);
     Gradients sigma;
@@ -126,7 +126,10 @@ class TaylorQuadrature {
       sigma[a] = weight_[i] * stressOf(i, A[a]);
       Pq.noalias() += G[a] * sigma[a];
     }
-    R_[i].noalias() = F * symmetric(sigma);  // R_a = F sigma_a (symmetric)
+    // R_a = F sigma_a (symmetric). In 2D the D top rows are all the padded rows; naming them
+    // (here and above) keeps the body well-formed for D = 3, which Clang 14 instantiates
+    // against the constraint through the explicit instantiation in TaylorQuadrature.cpp.
+    R_[i].template topRows<D>().noalias() = F * symmetric(sigma);
     return Pq;
   }
 
