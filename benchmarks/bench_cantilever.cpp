@@ -5,10 +5,6 @@
 // bandwidth (a plain copy on the same threads).
 // Under mpirun (a build with MPI) the step is distributed as in `tlsph run`, and the time in
 // halo exchanges and reductions is reported (issue 11's scaling tables, docs/performance.md).
-#ifdef _OPENMP
-#include <omp.h>
-#endif
-
 #include <algorithm>
 #include <boost/program_options.hpp>
 #include <chrono>
@@ -23,6 +19,7 @@
 #include "tlsph/Lattice.hpp"
 #include "tlsph/Prefetch.hpp"
 #include "tlsph/Solver.hpp"
+#include "tlsph/Threads.hpp"
 #ifdef TLSPH_HAVE_MPI
 #include <mpi.h>
 
@@ -33,15 +30,6 @@ namespace po = boost::program_options;
 using namespace tlsph;
 
 namespace {
-
-// The threads the step runs on (1 in a build without OpenMP, -DTLSPH_OPENMP=OFF).
-int threads() {
-#ifdef _OPENMP
-  return omp_get_max_threads();
-#else
-  return 1;
-#endif
-}
 
 // Bytes per second of `b = a` over 2 x 512 MB (read + written, as STREAM counts a copy), best
 // of five, on the OpenMP threads; far out of any cache.
@@ -180,7 +168,7 @@ int main(int argc, char** argv) {
   const auto& nb = solver.reference().neighbours;
   std::cout << "particles " << scene.particles.size() << " (" << nx * ny * ny << " body), "
             << "mean neighbours " << double(nb.pairCount()) / nb.particleCount() << ", threads "
-            << threads() << ", dt " << solver.timeStep() << ", " << correction << " correction, "
+            << maxThreads() << ", dt " << solver.timeStep() << ", " << correction << " correction, "
             << quadrature << " quadrature, hourglass " << form;
   if (jitter > 0.0) std::cout << ", jitter " << jitter << " dx";
   std::cout << "\n";
@@ -233,7 +221,7 @@ int main(int argc, char** argv) {
   if (stream && ranks == 1) {
     const double copy = copyBandwidth();
     std::cout << " = " << 100.0 * rate * bytes / copy << " % of a plain copy's " << copy / 1e9
-              << " GB/s (" << threads() << " threads)";
+              << " GB/s (" << maxThreads() << " threads)";
   }
   std::cout << "\n";
 #ifdef TLSPH_HAVE_MPI

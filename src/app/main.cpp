@@ -23,10 +23,8 @@
 #include "scene/InputError.hpp"
 #include "scene/SceneBuilder.hpp"
 #include "tlsph/Errors.hpp"
+#include "tlsph/Threads.hpp"
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 #ifdef TLSPH_HAVE_MPI
 #include <mpi.h>
 
@@ -216,14 +214,6 @@ void addSolverWarnings(SceneSetup<D>& setup, const Solver<D>& solver, const std:
   std::cerr << command << ": warning: " << w.str() << "\n";
 }
 
-int ompThreads() {
-#ifdef _OPENMP
-  return omp_get_max_threads();
-#else
-  return 1;
-#endif
-}
-
 // What a checkpoint records to recognise its run: version, scene text, overrides, settings.
 CheckpointOrigin runOrigin(const Config& config, const RunFlags& flags, int threads) {
   CheckpointOrigin origin;
@@ -270,7 +260,7 @@ int runOrCheck(const Config& config, bool run, bool progress, const std::string&
     printSetup(setup, solver);
     return 0;
   }
-  const int threads = ompThreads();
+  const int threads = maxThreads();
   RunOptions options;
   options.progress = progress;
   options.command = command;
@@ -521,7 +511,7 @@ int tlsphMain(int argc, char** argv, Communicator* comm) {
         throw std::runtime_error("tlsph modes runs on one rank only: start it without mpirun");
       modes.run.command = command;
       modes.run.progress = progress;
-      modes.run.origin = runOrigin(config, flags, ompThreads());
+      modes.run.origin = runOrigin(config, flags, maxThreads());
       if (d == 2) {
         SceneSetup<2> setup = buildScene<2>(config);
         return runModes<2>(setup, modes);

@@ -40,9 +40,6 @@
 #if defined(__AVX512F__) && defined(__AVX512DQ__)
 #include <immintrin.h>
 #endif
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 #include "tlsph/LargePageAllocator.hpp"
 #include "tlsph/MeetInTheMiddle.hpp"
@@ -51,6 +48,7 @@
 #include "tlsph/Prefetch.hpp"
 #include "tlsph/SharedRows.hpp"
 #include "tlsph/TaylorQuadrature.hpp"
+#include "tlsph/Threads.hpp"
 #include "tlsph/Types.hpp"
 
 namespace tlsph {
@@ -130,11 +128,8 @@ class InternalForceScatter {
     const Index sourceCount = listed ? static_cast<Index>(sources_.size()) : n;
 #pragma omp parallel
     {
-#ifdef _OPENMP
-      const Index threads = omp_get_num_threads(), thread = omp_get_thread_num();
-#else
-      const Index threads = 1, thread = 0;
-#endif
+      const ThreadSlot slot = threadSlot();
+      const Index threads = slot.threads, thread = slot.thread;
       // where the pass before met (a static share when it ran over other particles)
       const auto [p0, p1] = split.shareOf(count, thread, threads);
       if (p0 < p1) {

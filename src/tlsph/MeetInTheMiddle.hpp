@@ -18,10 +18,7 @@
 #include <cstdint>
 #include <vector>
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
-
+#include "tlsph/Threads.hpp"
 #include "tlsph/Types.hpp"
 
 namespace tlsph {
@@ -37,11 +34,7 @@ class MeetInTheMiddle {
 
   // Outside a parallel region, before a pass over [0, count) on the threads the next region has.
   void reset(Index count) {
-#ifdef _OPENMP
-    const int threads = omp_get_max_threads();
-#else
-    const int threads = 1;
-#endif
+    const int threads = maxThreads();
     // a Pair cannot move (its atomic), so a larger thread count takes a new vector
     if (static_cast<std::size_t>(threads / 2) > pairs_.size())
       pairs_ = std::vector<Pair>(static_cast<std::size_t>(threads / 2));
@@ -60,10 +53,9 @@ class MeetInTheMiddle {
   class Chunks {
    public:
     Chunks(MeetInTheMiddle* split, Index count) : count_(count) {
-#ifdef _OPENMP
-      thread_ = omp_get_thread_num();
-      threads_ = omp_get_num_threads();
-#endif
+      const ThreadSlot slot = threadSlot();
+      thread_ = slot.thread;
+      threads_ = slot.threads;
       // shared with the other thread of its pair, unless the region is not the one reset() saw
       if (split && split->count_ == count && split->threads_ == threads_ &&
           thread_ / 2 < threads_ / 2)
@@ -126,12 +118,8 @@ class MeetInTheMiddle {
   static std::uint64_t pack(Index lower, Index upper) {
     return (std::uint64_t(std::uint32_t(lower)) << 32) | std::uint32_t(upper);
   }
-  static Index lowerOf(std::uint64_t ends) {
-    return static_cast<Index>(ends >> 32);
-  }
-  static Index upperOf(std::uint64_t ends) {
-    return static_cast<Index>(ends & 0xffffffffu);
-  }
+  static Index lowerOf(std::uint64_t ends) { return static_cast<Index>(ends >> 32); }
+  static Index upperOf(std::uint64_t ends) { return static_cast<Index>(ends & 0xffffffffu); }
   std::array<Index, 2> pairRange(int k) const {
     return {staticBegin(count_, 2 * k, threads_), staticBegin(count_, 2 * k + 2, threads_)};
   }

@@ -4,27 +4,9 @@
 
 #include <utility>
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
+#include "tlsph/Threads.hpp"
 
 namespace tlsph {
-
-namespace {
-// This thread's number and the team's size (0 of 1 without OpenMP). Plain variables, not a
-// structured binding: clang 14 (Debian's, which the fuzz build uses) cannot capture those in a
-// lambda.
-struct ThreadSlot {
-  int thread, threads;
-};
-ThreadSlot threadSlot() {
-#ifdef _OPENMP
-  return {omp_get_thread_num(), omp_get_num_threads()};
-#else
-  return {0, 1};
-#endif
-}
-}  // namespace
 
 template <int D>
 void TangentStiffness<D>::update(std::span<const Mat<D>> F) {
