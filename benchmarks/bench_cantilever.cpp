@@ -1,4 +1,4 @@
-// Throughput benchmark on the 3D cantilever of DESIGN.md section 6: particle-steps per second
+// Throughput benchmark on the 3D cantilever of docs/method.md section 6: particle-steps per second
 // of the full step (F, P, internal and hourglass forces, integrator). Not a test: it prints.
 // With it, the roofline's numbers (issue 12, docs/performance.md): the force passes' counted
 // memory traffic per particle-step, the bandwidth that traffic reaches, and the machine's own
@@ -15,15 +15,15 @@
 #include <vector>
 
 #include "geometry/LocalityOrder.hpp"
-#include "tlsph/LargePageAllocator.hpp"
-#include "tlsph/Lattice.hpp"
-#include "tlsph/Prefetch.hpp"
-#include "tlsph/Solver.hpp"
-#include "tlsph/Threads.hpp"
+#include "execution/LargePageAllocator.hpp"
+#include "geometry/Lattice.hpp"
+#include "execution/Prefetch.hpp"
+#include "explicit/Solver.hpp"
+#include "execution/Threads.hpp"
 #ifdef TLSPH_HAVE_MPI
 #include <mpi.h>
 
-#include "parallel/MpiCommunicator.hpp"
+#include "distributed/MpiCommunicator.hpp"
 #endif
 
 namespace po = boost::program_options;

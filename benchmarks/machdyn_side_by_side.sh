@@ -18,7 +18,7 @@
 # at dx 0.0125 plus ceil(2.1) = 3 clamp layers at x < 0 that never move), volume dx^3, density
 # 1000, E = 1e7, nu = 0.3, gravity (0, 0, -1), the kernel support H = 2.1 dx (32 neighbours
 # inside), the step count, no artificial viscosity, and one fixed time step of CFL dx / c with
-# c = sqrt((K + 4G/3)/rho). tlsph adds the hourglass term's speed to c (src/tlsph/TimeStep.hpp),
+# c = sqrt((K + 4G/3)/rho). tlsph adds the hourglass term's speed to c (src/method/TimeStep.hpp),
 # so its dt is a little smaller; the table shows both. The cost of a step does not depend on dt.
 # NOT equal: the material model. MACHDYN has no neo-Hookean model; its only elastic model is
 # hypoelastic: *STRENGTH_LINEAR (deviatoric stress rate 2G d_dev) with *EOS_LINEAR (pressure rate

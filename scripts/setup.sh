@@ -88,7 +88,7 @@ case "$action" in
     ctest --test-dir "$build_dir" --output-on-failure -j "$jobs"
     ;;
   example)
-    # The 3D cantilever under self-weight (DESIGN.md section 6), run to static equilibrium.
+    # The 3D cantilever under self-weight (docs/method.md section 6), run to static equilibrium.
     "$build_dir/tlsph" run examples/cantilever.ini --output.directory=output/cantilever --overwrite
     echo "setup: open $(pwd)/output/cantilever/cantilever.pvd in ParaView"
     ;;

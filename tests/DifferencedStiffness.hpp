@@ -5,7 +5,7 @@
 #include <Eigen/Dense>
 #include <vector>
 
-#include "tlsph/Solver.hpp"
+#include "explicit/Solver.hpp"
 
 namespace tlsph::testing {
 

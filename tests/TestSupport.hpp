@@ -9,10 +9,10 @@
 #include <vector>
 
 #include "materials/Material.hpp"
-#include "tlsph/Lattice.hpp"
-#include "tlsph/ReferenceConfiguration.hpp"
-#include "tlsph/Scene.hpp"
-#include "tlsph/TlsphForces.hpp"
+#include "geometry/Lattice.hpp"
+#include "method/ReferenceConfiguration.hpp"
+#include "model/Scene.hpp"
+#include "fast/TlsphForces.hpp"
 
 namespace tlsph::testing {
 

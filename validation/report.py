@@ -1082,7 +1082,7 @@ def references_section(R):
              "the mirrored clamp's u = 0 on the face; linear, uniform meshes %s), "
              "centre mid-surface deflection **%.4f mm** converged (%s), "
              "%.4f mm on the finest mesh: the headline's reference. The earlier reference "
-             "%.4f mm (40 x 40 x 4 elements, DESIGN.md section 6) is not converged through "
+             "%.4f mm (40 x 40 x 4 elements, docs/method.md section 6) is not converged through "
              "the thickness (the deflection converges at order about 1 there: the edge "
              "singularity where the clamped faces meet the top and bottom). w/t is below "
              "2 %%, so the material law (Saint Venant-Kirchhoff in the scene) does not "

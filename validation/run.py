@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""tlsph validation: error against run time, for the reference problems of DESIGN.md section 6.
+"""tlsph validation: error against run time, for the reference problems of docs/method.md section 6.
 
 From the repository root (the build must exist: `bash scripts/setup.sh build`):
 
@@ -150,7 +150,7 @@ def _fem_mesh(fem, case):
 
 
 def compute_references(fem_path=FEM_JSON):
-    """Reference numbers (DESIGN.md section 6, the sources cited in the scene files, and the
+    """Reference numbers (docs/method.md section 6, the sources cited in the scene files, and the
     CalculiX models of validation/fem.py read from validation/fem/references.json)."""
     fem = load_fem_references(fem_path)
     r = {}
@@ -210,7 +210,7 @@ def compute_references(fem_path=FEM_JSON):
         "w_fem_mesh": _fem_mesh(fem, "clamped_plate"),
         "w_fem_meshes": fem_meshes(fem, "clamped_plate"),
         "w_fem_order": fem_order(fem, "clamped_plate", "centre_deflection"),
-        # the earlier reference (DESIGN.md section 6), 40 x 40 x 4 elements
+        # the earlier reference (docs/method.md section 6), 40 x 40 x 4 elements
         "w_fem_previous": prev[0]["values"]["centre_deflection"] if prev else 0.8121e-3,
     }
     # Cantilever under g = 30: Saint Venant-Kirchhoff, NLGEOM.

@@ -15,10 +15,10 @@
 #include <vector>
 
 #include "app/Guards.hpp"
-#include "output/CheckpointArchive.hpp"
+#include "io/CheckpointArchive.hpp"
 #include "output/PvdFile.hpp"
-#include "tlsph/NewtonSolver.hpp"
-#include "tlsph/Solver.hpp"
+#include "implicit/NewtonSolver.hpp"
+#include "explicit/Solver.hpp"
 
 namespace tlsph {
 

@@ -11,7 +11,7 @@
 #include <system_error>
 #include <vector>
 
-#include "output/CheckpointArchive.hpp"
+#include "io/CheckpointArchive.hpp"
 #include "scene/SceneSetup.hpp"
 
 namespace tlsph {

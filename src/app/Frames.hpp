@@ -11,7 +11,7 @@
 
 #include "output/Frame.hpp"
 #include "scene/SceneSetup.hpp"
-#include "tlsph/Solver.hpp"
+#include "explicit/Solver.hpp"
 
 namespace tlsph {
 

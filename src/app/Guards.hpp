@@ -50,8 +50,8 @@
 #include "app/Frames.hpp"
 #include "output/VtuFile.hpp"
 #include "scene/SceneSetup.hpp"
-#include "tlsph/Diagnostics.hpp"
-#include "tlsph/Solver.hpp"
+#include "explicit/Diagnostics.hpp"
+#include "explicit/Solver.hpp"
 
 namespace tlsph {
 

@@ -16,7 +16,7 @@
 #include "output/CsvSeries.hpp"
 #include "output/VtuSeriesWriter.hpp"
 #include "scene/SceneSetup.hpp"
-#include "tlsph/ModalAnalysis.hpp"
+#include "implicit/ModalAnalysis.hpp"
 
 namespace tlsph {
 

@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "scene/SceneSetup.hpp"
-#include "tlsph/Solver.hpp"
+#include "explicit/Solver.hpp"
 
 namespace tlsph {
 

@@ -9,9 +9,9 @@
 #include <string>
 
 #include "app/RunSimulation.hpp"
-#include "output/AtomicFile.hpp"
-#include "output/JsonText.hpp"
-#include "output/RoundTripNumber.hpp"
+#include "io/AtomicFile.hpp"
+#include "io/JsonText.hpp"
+#include "io/RoundTripNumber.hpp"
 
 namespace tlsph {
 

@@ -21,8 +21,8 @@
 #include "output/CsvSeries.hpp"
 #include "output/VtuSeriesWriter.hpp"
 #include "scene/SceneSetup.hpp"
-#include "tlsph/Diagnostics.hpp"
-#include "tlsph/Solver.hpp"
+#include "explicit/Diagnostics.hpp"
+#include "explicit/Solver.hpp"
 
 namespace tlsph {
 

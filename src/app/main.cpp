@@ -22,13 +22,13 @@
 #include "scene/Config.hpp"
 #include "scene/InputError.hpp"
 #include "scene/SceneBuilder.hpp"
-#include "tlsph/Errors.hpp"
-#include "tlsph/Threads.hpp"
+#include "model/Errors.hpp"
+#include "execution/Threads.hpp"
 
 #ifdef TLSPH_HAVE_MPI
 #include <mpi.h>
 
-#include "parallel/MpiCommunicator.hpp"
+#include "distributed/MpiCommunicator.hpp"
 #endif
 
 namespace {

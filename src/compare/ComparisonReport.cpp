@@ -6,8 +6,8 @@
 #include <stdexcept>
 
 #include "compare/FieldLayout.hpp"
-#include "output/AtomicFile.hpp"
-#include "output/JsonText.hpp"
+#include "io/AtomicFile.hpp"
+#include "io/JsonText.hpp"
 
 namespace tlsph {
 

@@ -18,7 +18,7 @@
 #include <limits>
 #include <stdexcept>
 
-#include "compare/VtkErrorLog.hpp"
+#include "output/VtkErrorLog.hpp"
 
 namespace tlsph {
 

@@ -13,7 +13,7 @@
 #include <string>
 
 #include "compare/RunFrame.hpp"
-#include "compare/VtkErrorLog.hpp"
+#include "output/VtkErrorLog.hpp"
 
 namespace tlsph {
 

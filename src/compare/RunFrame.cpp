@@ -10,7 +10,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "compare/VtkErrorLog.hpp"
+#include "output/VtkErrorLog.hpp"
 
 namespace tlsph {
 

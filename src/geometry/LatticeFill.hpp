@@ -15,8 +15,8 @@
 #include "geometry/MessageText.hpp"
 #include "geometry/PointSets.hpp"  // select() and boundingBox() go with filling
 #include "geometry/Shape.hpp"
-#include "tlsph/LatticeGrid.hpp"
-#include "tlsph/Types.hpp"
+#include "geometry/LatticeGrid.hpp"
+#include "model/Types.hpp"
 
 namespace tlsph {
 

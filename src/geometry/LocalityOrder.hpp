@@ -12,7 +12,7 @@
 #include <numeric>
 #include <vector>
 
-#include "tlsph/Types.hpp"
+#include "model/Types.hpp"
 
 namespace tlsph {
 

@@ -5,7 +5,7 @@
 #include <string>
 #include <string_view>
 
-#include "tlsph/Types.hpp"
+#include "model/Types.hpp"
 
 namespace tlsph::geometry_detail {
 

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "geometry/Shape.hpp"
-#include "tlsph/Types.hpp"
+#include "model/Types.hpp"
 
 namespace tlsph {
 

@@ -9,7 +9,7 @@
 #include <utility>
 #include <vector>
 
-#include "tlsph/Types.hpp"
+#include "model/Types.hpp"
 
 namespace tlsph::polygon {
 

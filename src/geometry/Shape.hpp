@@ -16,7 +16,7 @@
 
 #include "geometry/MessageText.hpp"
 #include "geometry/PolygonOps.hpp"
-#include "tlsph/Types.hpp"
+#include "model/Types.hpp"
 
 namespace tlsph {
 

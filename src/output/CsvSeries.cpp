@@ -3,8 +3,8 @@
 #include <fstream>
 #include <stdexcept>
 
-#include "output/AtomicFile.hpp"
-#include "output/RoundTripNumber.hpp"
+#include "io/AtomicFile.hpp"
+#include "io/RoundTripNumber.hpp"
 
 namespace tlsph {
 

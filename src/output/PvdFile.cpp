@@ -4,9 +4,9 @@
 #include <stdexcept>
 #include <string>
 
-#include "output/AtomicFile.hpp"
-#include "output/RoundTripNumber.hpp"
-#include "output/XmlText.hpp"
+#include "io/AtomicFile.hpp"
+#include "io/RoundTripNumber.hpp"
+#include "io/XmlText.hpp"
 
 namespace tlsph {
 

@@ -4,8 +4,8 @@
 #include <set>
 #include <stdexcept>
 
-#include "output/AtomicFile.hpp"
-#include "output/XmlText.hpp"
+#include "io/AtomicFile.hpp"
+#include "io/XmlText.hpp"
 
 namespace tlsph {
 

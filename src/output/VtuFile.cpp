@@ -22,7 +22,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "output/AtomicFile.hpp"
+#include "io/AtomicFile.hpp"
 
 namespace tlsph {
 

@@ -17,7 +17,7 @@
 #include "geometry/LocalityOrder.hpp"
 #include "geometry/Shape.hpp"
 #include "scene/SectionReader.hpp"
-#include "tlsph/Kernel.hpp"
+#include "method/Kernel.hpp"
 
 namespace tlsph {
 
@@ -757,7 +757,7 @@ class Builder {
         setup_.conditions.push_back("initial." + name + ": rotation " +
                                     rotationText<D>(axis, point, rate));
       } else {
-        // First cantilever mode shape (DESIGN.md section 6, oscillating plate):
+        // First cantilever mode shape (docs/method.md section 6, oscillating plate):
         // v(s) = amplitude f(s)/f(L) along `direction`, s the distance from `origin` along `axis`.
         const std::string axisName = r.word("axis", "x", {"x", "y", "z"});
         const int axis = axisName[0] - 'x';

@@ -12,7 +12,7 @@
 
 #include "scene/Config.hpp"
 #include "scene/InputError.hpp"
-#include "tlsph/Types.hpp"
+#include "model/Types.hpp"
 
 namespace tlsph {
 

@@ -1,0 +1,45 @@
+// Particle storage as a structure of arrays: one contiguous array per field.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "model/Types.hpp"
+
+namespace tlsph {
+
+// How a particle moves: by the integrator, by a prescription (fixed clamps, driven
+// boundaries), or as the odd mirror image of a body particle (mirrored clamp ghosts: u = -u_M).
+// Prescribed and mirrored particles take part in every neighbour sum.
+enum class Motion : std::uint8_t { Free, Prescribed, Mirrored };
+
+template <int D>
+struct ParticleSet {
+  std::vector<Vec<D>> referencePosition;  // X_I
+  std::vector<Vec<D>> displacement;       // u_I, x_I = X_I + u_I
+  std::vector<Vec<D>> velocity;           // v_I
+  std::vector<Vec<D>> force;              // total force on I (internal + hourglass + external)
+  std::vector<double> volume;             // V_I (area per unit thickness in 2D)
+  std::vector<double> mass;               // m_I = rho0 V_I
+  std::vector<std::uint16_t> material;    // index into the scene's materials
+  std::vector<Motion> motion;
+
+  Index size() const { return static_cast<Index>(referencePosition.size()); }
+
+  Index add(const Vec<D>& X, double V, double m, std::uint16_t materialIndex,
+            Motion how = Motion::Free) {
+    referencePosition.push_back(X);
+    displacement.push_back(Vec<D>::Zero());
+    velocity.push_back(Vec<D>::Zero());
+    force.push_back(Vec<D>::Zero());
+    volume.push_back(V);
+    mass.push_back(m);
+    material.push_back(materialIndex);
+    motion.push_back(how);
+    return size() - 1;
+  }
+
+  Vec<D> currentPosition(Index i) const { return referencePosition[i] + displacement[i]; }
+};
+
+}  // namespace tlsph
