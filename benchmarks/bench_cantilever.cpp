@@ -1,10 +1,10 @@
 // Throughput benchmark on the 3D cantilever of docs/method.md section 6: particle-steps per second
 // of the full step (F, P, internal and hourglass forces, integrator). Not a test: it prints.
-// With it, the roofline's numbers (issue 12, docs/performance.md): the force passes' counted
+// With it, the roofline's numbers (docs/performance.md): the force passes' counted
 // memory traffic per particle-step, the bandwidth that traffic reaches, and the machine's own
 // bandwidth (a plain copy on the same threads).
 // Under mpirun (a build with MPI) the step is distributed as in `tlsph run`, and the time in
-// halo exchanges and reductions is reported (issue 11's scaling tables, docs/performance.md).
+// halo exchanges and reductions is reported (the scaling tables of docs/performance.md).
 #include <algorithm>
 #include <boost/program_options.hpp>
 #include <chrono>

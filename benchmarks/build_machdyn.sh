@@ -1,6 +1,6 @@
 #!/bin/bash
-# Builds LAMMPS with the MACHDYN package (pair smd/tlsph) for benchmarks/machdyn_side_by_side.sh
-# (issue 12). Not a tlsph dependency: only the side-by-side benchmark uses it.
+# Builds LAMMPS with the MACHDYN package (pair smd/tlsph) for benchmarks/machdyn_side_by_side.sh.
+# Not a tlsph dependency: only the side-by-side benchmark uses it.
 # Debian's `lammps` package is built without MACHDYN, so this takes the source Debian ships
 # (LAMMPS stable 7 Jan 2022, the bookworm package 20220106.git7586adbb6a+ds1, MACHDYN included),
 # checks it against the checksum in Debian's .dsc, and builds only the core and MACHDYN with MPI

@@ -1,6 +1,6 @@
 #!/bin/bash
 # Side-by-side throughput of LAMMPS's MACHDYN (pair smd/tlsph) and build/tlsph_bench on the same
-# 3D cantilever (benchmarks/bench_cantilever.cpp; issue 12). Needs a LAMMPS built from source with
+# 3D cantilever (benchmarks/bench_cantilever.cpp). Needs a LAMMPS built from source with
 # the MACHDYN package (not a tlsph dependency; Debian's lammps package lacks it):
 # benchmarks/build_machdyn.sh builds one from Debian's LAMMPS source and prints its path.
 # Prints particle-steps/s = atoms x steps / loop time. Written from LAMMPS's documentation,
@@ -8,8 +8,8 @@
 # Usage: benchmarks/machdyn_side_by_side.sh LMP_BINARY [dx] [steps] [procs...]
 #   e.g. benchmarks/machdyn_side_by_side.sh "$(benchmarks/build_machdyn.sh)" 0.0125 2000
 #   defaults: dx 0.0125 (5,312 particles), steps 200, procs "1 2" (MACHDYN: MPI ranks, one
-#   OpenMP thread each; tlsph: OpenMP threads, one process). Issue 12's sizes: 0.0125 2000 and
-#   0.00625 200. Environment: MPIRUN (default mpirun), HG (both codes' hourglass coefficient,
+#   OpenMP thread each; tlsph: OpenMP threads, one process). The sizes in
+#   docs/performance.md: 0.0125 2000 and 0.00625 200. Environment: MPIRUN (default mpirun), HG (both codes' hourglass coefficient,
 #   default 10), CFL (default 0.3), PAIRED=1 (one core each, both codes at once; below),
 #   ROUNDS=N (the codes in turn, N times, each tlsph rate against the MACHDYN runs either side of
 #   it; below).

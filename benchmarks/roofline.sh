@@ -1,5 +1,5 @@
 #!/bin/bash
-# The roofline table of docs/performance.md (issue 12): build/tlsph_bench on the 3D cantilever
+# The roofline table of docs/performance.md: build/tlsph_bench on the 3D cantilever
 # at about 10^4, 10^5 and 10^6 particles, the benchmark's rows (linear correction, nodal
 # quadrature) and the scene defaults (quadratic correction, Taylor quadrature), on 1 and 2
 # threads. Each line: particles, configuration, threads, particle-steps/s, the force passes'

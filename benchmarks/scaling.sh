@@ -1,5 +1,5 @@
 #!/bin/bash
-# Strong and weak scaling of the distributed explicit step on this machine (issue 11; the
+# Strong and weak scaling of the distributed explicit step on this machine (the
 # tables in docs/performance.md). Runs build/tlsph_bench (built with MPI) on the 3D cantilever
 # at the scene defaults (quadratic correction, Taylor quadrature, energy penalty alpha = 10),
 # one OpenMP thread per rank, ranks 1, 2 and 4 (4 oversubscribed on 2 cores), and one rank on

@@ -4,7 +4,7 @@
 #
 #   scripts/setup.sh build     install + build (default)
 #   scripts/setup.sh test      install + build + run the test suite (ctest)
-#   scripts/setup.sh example   install + build + run the main example scene
+#   scripts/setup.sh example   install + build the program + run the main example scene
 #   scripts/setup.sh validate  install (+ numpy, matplotlib) + build + run the full validation
 #                              ladder (validation/run.py, ~30 min on 2 cores): validation/report/
 #   scripts/setup.sh stability install (+ numpy, matplotlib) + build + run the stability map
@@ -80,7 +80,12 @@ if [ "$action" = fuzz ]; then
 fi
 
 cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build "$build_dir" -j "$jobs"
+if [ "$action" = example ]; then
+  # The example runs the program only: the test programs are not needed for it.
+  cmake --build "$build_dir" -j "$jobs" --target tlsph
+else
+  cmake --build "$build_dir" -j "$jobs"
+fi
 
 case "$action" in
   build) ;;

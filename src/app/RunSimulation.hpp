@@ -17,12 +17,12 @@
 #include "app/CheckpointSchedule.hpp"
 #include "app/Frames.hpp"
 #include "app/Guards.hpp"
+#include "app/RunSeries.hpp"
 #include "app/StopRequest.hpp"
-#include "output/CsvSeries.hpp"
-#include "output/VtuSeriesWriter.hpp"
-#include "scene/SceneSetup.hpp"
 #include "explicit/Diagnostics.hpp"
 #include "explicit/Solver.hpp"
+#include "output/VtuSeriesWriter.hpp"
+#include "scene/SceneSetup.hpp"
 
 namespace tlsph {
 
@@ -59,63 +59,6 @@ struct RunSummary {
   PartitionSummary partition;  // ranks, and how the particles were split among them
 };
 
-template <int D>
-std::vector<std::string> probeColumns(const SceneSetup<D>& setup) {
-  std::vector<std::string> columns = {"time", "step"};
-  const char* axes = "xyz";
-  for (const auto& probe : setup.probes)
-    for (const auto& q : probe.quantities) {
-      if (q == "cauchy_stress") {
-        for (const char* c : {"xx", "yy", "zz", "xy", "yz", "xz"})
-          columns.push_back(probe.name + "_s" + c);
-        continue;
-      }
-      for (int a = 0; a < D; ++a)
-        columns.push_back(probe.name + "_" + (q == "displacement" ? "u" : "v") + axes[a]);
-    }
-  return columns;
-}
-
-template <int D>
-std::vector<double> probeRow(const SceneSetup<D>& setup, const Solver<D>& solver) {
-  const auto& p = setup.scene.particles;
-  const auto& F = solver.forces().deformationGradient();
-  const auto* quadrature = solver.forces().quadrature();
-  std::vector<double> row = {solver.time(), double(solver.stepCount())};
-  for (const auto& probe : setup.probes)
-    for (const auto& q : probe.quantities) {
-      if (q == "cauchy_stress") {
-        // The weighted particle stresses (Shepard; the probe's weights), xx yy zz xy yz xz.
-        Mat3 s = Mat3::Zero();
-        for (std::size_t k = 0; k < probe.particles.size(); ++k)
-          s += probe.weights[k] * cauchyStressOf(setup, F[probe.particles[k]], probe.particles[k]);
-        row.insert(row.end(), {s(0, 0), s(1, 1), s(2, 2), s(0, 1), s(1, 2), s(0, 2)});
-        continue;
-      }
-      const bool displacement = q == "displacement";
-      const auto& field = displacement ? p.displacement : p.velocity;
-      const bool firstOrder = displacement && !probe.offsets.empty();
-      Vec<D> value = Vec<D>::Zero();
-      for (std::size_t k = 0; k < probe.particles.size(); ++k) {
-        const Index j = probe.particles[k];
-        Vec<D> u = field[j];
-        if (firstOrder) u += (F[j] - Mat<D>::Identity()) * probe.offsets[k];  // u(X_J + d)
-        // With [kernel] quadrature = taylor the fit's second derivatives are at hand: carry
-        // u to second order, + 1/2 d . grad grad u_J d (issue 8: the first-order carry reads a
-        // plate's centre deflection 0.4 % high at 4 through, by 1/2 |w''| <d^2>).
-        if (firstOrder && quadrature) {
-          const auto G = TaylorQuadrature<D>::unpack(quadrature->secondGradients()[j]);
-          for (int a = 0; a < D; ++a)
-            u += 0.5 * probe.offsets[k][a] * (G[a] * probe.offsets[k]);
-        }
-        value += probe.weights[k] * u;
-      }
-      for (int a = 0; a < D; ++a)
-        row.push_back(value[a]);
-    }
-  return row;
-}
-
 // A file of the run's output could not be written; the run stops (RunOutcome::OutputFailed).
 class OutputWriteFailure : public std::runtime_error {
   using std::runtime_error::runtime_error;
@@ -139,7 +82,6 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
   Solver<D> solver(setup.scene, setup.solver, comm);
   onStart(solver);
   if (resume) solver.restore(resume->solver);
-  const auto& p = setup.scene.particles;
   const RunSettings& run = setup.run;
   const OutputSettings& out = setup.output;
   const fs::path dir = out.directory;
@@ -147,64 +89,10 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
   // Serially one .vtu per frame; distributed, each rank writes its piece and rank 0 the index.
   std::unique_ptr<VtuSeriesWriter> vtu;
   if (!out.fields.empty()) vtu = std::make_unique<VtuSeriesWriter>(dir, setup.name);
-  const std::vector<std::string> preamble = {
-      "tlsph scene " + setup.name + " from " + setup.sourceFile, "command: " + options.command,
-      "SI units: s, m, J, kg m/s"};
-  std::vector<std::string> energyColumns = {
-      "time",   "step",  "kinetic",  "strain",     "hourglass",  "external_work", "boundary_work",
-      "damped", "total", "residual", "momentum_x", "momentum_y", "momentum_z"};
-  if (out.hourglassContent) energyColumns.push_back("hourglass_content");
-  CsvSeries energies(dir / "energies.csv", energyColumns);
-  energies.setPreamble(preamble);
-  std::unique_ptr<CsvSeries> probes;
-  if (!setup.probes.empty()) {
-    probes = std::make_unique<CsvSeries>(dir / "probes.csv", probeColumns(setup));
-    probes->setPreamble(preamble);
-  }
-
-  // reactions.csv: the force each clamp and prescription exerts on the body.
-  std::unique_ptr<CsvSeries> reactions;
-  const auto& rules = setup.scene.prescriptions;
-  if (!rules.empty()) {
-    std::vector<std::string> columns = {"time", "step"};
-    for (const auto& rule : rules)
-      for (int a = 0; a < D; ++a)
-        columns.push_back(rule.name + "_" + "xyz"[a]);
-    reactions = std::make_unique<CsvSeries>(dir / "reactions.csv", columns);
-    reactions->setPreamble(preamble);
-  }
-  auto reactionRow = [&] {
-    std::vector<double> row = {solver.time(), double(solver.stepCount())};
-    for (std::size_t r = 0; r < rules.size(); ++r) {
-      const Vec<D> R = solver.reaction(r);
-      row.insert(row.end(), R.data(), R.data() + D);
-    }
-    return row;
-  };
-
+  RunSeries<D> series(setup, options.command);
   auto recordSeries = [&] {
     solver.synchronize();
-    const EnergyBalance e = solver.energyBalance();
-    Vec3 momentum = Vec3::Zero();
-    momentum.head<D>() = linearMomentum(p);
-    std::vector<double> row = {solver.time(),  double(solver.stepCount()),
-                               e.kinetic,      e.strain,
-                               e.hourglass,    e.externalWork,
-                               e.boundaryWork, e.damped,
-                               e.total(),      solver.residualRatio(),
-                               momentum.x(),   momentum.y(),
-                               momentum.z()};
-    if (out.hourglassContent) {
-      const auto& F = solver.forces().deformationGradient();
-      std::vector<Mat<D>> H(F.begin(), F.end());
-      for (auto& h : H)
-        h -= Mat<D>::Identity();
-      row.push_back(hourglassContent(solver.reference(), p.volume, p.displacement, H,
-                                     solver.ownedParticles(), solver.communicator()));
-    }
-    energies.append(row);
-    if (probes) probes->append(probeRow(setup, solver));
-    if (reactions) reactions->append(reactionRow());
+    series.record(solver);
   };
   // Every write goes through here: a failure stops the run as OutputFailed. Rank 0 writes and
   // tells the others how it went.
@@ -231,13 +119,7 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
     }
     if (comm->firstNonEmpty(failure) >= 0) throw OutputWriteFailure(failure);
   };
-  auto flushSeries = [&] {
-    writing([&] {
-      energies.flush();
-      if (probes) probes->flush();
-      if (reactions) reactions->flush();
-    });
-  };
+  auto flushSeries = [&] { writing([&] { series.flush(); }); };
   long lastFrameStep = -1;
   double nextFrameTime = out.everyTime;
   auto writeFrame = [&] {
@@ -268,9 +150,7 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
     // The output as it was at the checkpoint: later rows and frames (written before the stop)
     // are dropped, so the continuation has neither duplicates nor gaps.
     const OutputProgress& o = resume->output;
-    energies.resume(o.energyRows);
-    if (probes) probes->resume(o.probeRows);
-    if (reactions) reactions->resume(o.reactionRows);
+    series.resume(o);
     if (vtu) vtu->resume(o.frames, root);
     lastFrameStep = o.lastFrameStep;
     nextFrameTime = o.nextFrameTime;
@@ -291,9 +171,7 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
     if (newton) c.newton = newton->state();
     c.output.nextFrameTime = nextFrameTime;
     c.output.lastFrameStep = lastFrameStep;
-    c.output.energyRows = energies.rowCount();
-    c.output.probeRows = probes ? probes->rowCount() : 0;
-    c.output.reactionRows = reactions ? reactions->rowCount() : 0;
+    series.countRows(c.output);
     if (vtu) c.output.frames = vtu->frames();
     const fs::path file = schedule.fileFor(solver.stepCount());
     writing([&] {
@@ -330,9 +208,10 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
     summary.partition = solver.partition();
     summary.wallSeconds = std::chrono::duration<double>(Clock::now() - start).count();
     if (vtu) summary.pvd = vtu->pvdPath();
-    summary.energies = dir / "energies.csv";
-    if (probes) summary.probes = dir / "probes.csv";
-    if (reactions) summary.reactions = dir / "reactions.csv";
+    summary.energies = series.energiesFile();
+    summary.probes = series.probesFile();
+    summary.reactions = series.reactionsFile();
+    const auto& rules = setup.scene.prescriptions;
     for (std::size_t r = 0; r < rules.size(); ++r) {
       Vec3 R = Vec3::Zero();
       R.head<D>() = solver.reaction(r);

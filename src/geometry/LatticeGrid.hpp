@@ -1,4 +1,4 @@
-// The binary grid that holds a cell-centred lattice's coordinates exactly (issue 12).
+// The binary grid that holds a cell-centred lattice's coordinates exactly.
 //
 // Coordinates origin + (n + 1/2) dx evaluated in floating point round differently at each n, so
 // two particles with the same neighbourhood see offsets X_J - X_I that differ in the last bits,

@@ -1,4 +1,4 @@
-// The order in which a scene numbers its lattice points (issue 12): the axis along which the
+// The order in which a scene numbers its lattice points: the axis along which the
 // points extend furthest varies slowest, the shortest fastest. A neighbour's index then lies
 // within about H/dx cross-sections of the particle's own (a beam along x numbered with x
 // fastest puts it H/dx whole x-y layers away), so the pair loops find the neighbours' values

@@ -1,4 +1,4 @@
-// Checkpoint/restart (issue 10): a run stopped at a random step and restarted from its
+// Checkpoint/restart: a run stopped at a random step and restarted from its
 // checkpoint ends bit for bit where the uninterrupted run ends (CSV series, VTU frames, PVD
 // index), in 2D and 3D, dynamic, damped static and Newton static; SIGTERM leaves a usable
 // checkpoint; foreign, damaged and mismatched checkpoints are refused with a message; the

@@ -75,7 +75,7 @@ TEST_F(EndToEnd, CantileverConvergesOnTimoshenkoDeflection) {
   // Converged CalculiX C3D20R of the same beam, face x = 0 clamped (validation/fem/
   // references.json, Richardson of 10x1x1 .. 80x8x8); tlsph at this resolution (8 through)
   // measured -0.12 % with the default Taylor quadrature (+1.58 % with the nodal sum, its
-  // 1/n^2 bending deficit): within the 0.5 % that issue 8 asks for at 16 through.
+  // 1/n^2 bending deficit): within the 0.5 % asked of it at 16 through.
   const double timoshenko = 0.01516, fem = 0.015022;
   std::cout << "cantilever tip deflection " << tip << " m (Timoshenko " << timoshenko << ", FEM "
             << fem << "): " << 100 * (tip - fem) / fem << " % against the FEM\n";

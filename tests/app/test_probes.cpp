@@ -3,7 +3,7 @@
 // particle cloud's hull (a beam tip); a nearest probe reports the nearest particle's value.
 #include <gtest/gtest.h>
 
-#include "app/RunSimulation.hpp"
+#include "app/RunSeries.hpp"
 #include "scene/Config.hpp"
 #include "scene/SceneBuilder.hpp"
 

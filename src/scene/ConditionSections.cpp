@@ -1,0 +1,204 @@
+// [clamp.NAME] and [prescribe.NAME]: the particles whose motion is given, and the clamps'
+// ghost layers.
+#include <cmath>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "scene/Builder.hpp"
+
+namespace tlsph::scene_build {
+
+template <int D>
+void Builder<D>::addClamps() {
+  const int layersNeeded = static_cast<int>(std::ceil(supportRatio_ - 1e-9));
+  auto& p = setup_.scene.particles;
+  const auto& X = p.referencePosition;
+  std::set<std::string> facesUsed;
+  for (const auto& name : config_.namesOf("clamp")) {
+    SectionReader r(config_, "clamp." + name);
+    const std::string face = r.word("face", std::nullopt, faceNames());
+    if (!facesUsed.insert(face).second) throw r.error("face", "face " + face + " is clamped twice");
+    const std::string method = r.word("method", "mirror", {"mirror", "mirror-quadratic", "fixed"});
+    const long layers = r.integer("layers", layersNeeded);
+    if (layers < layersNeeded)
+      throw r.error("layers", std::to_string(layers) +
+                                  " ghost layers do not fill the kernel support "
+                                  "(H/dx = " +
+                                  fmt(supportRatio_) + " needs " + std::to_string(layersNeeded) +
+                                  ")");
+    Prescription<D> clamp;
+    clamp.name = "clamp." + name;
+    const std::string motion = readMotion(r, clamp);
+    r.finish();
+    // The ghosts count against [scene] max_particles too (a mistyped `layers`).
+    Index onFace = 0;
+    for (Index i = 0; i < bodyCount_; ++i)
+      onFace += onBoundingFace(i, face) ? 1 : 0;
+    const double total = double(p.size()) + double(onFace) * double(layers);
+    if (total > double(maxParticles_))
+      throw r.error("layers", std::to_string(layers) + " ghost layers of the " +
+                                  std::to_string(onFace) + " particles on face " + face + " make " +
+                                  fmt(total) + " particles, more than [scene] max_particles = " +
+                                  std::to_string(maxParticles_));
+    const std::string holds = method == "fixed"
+                                  ? "holds face " + face
+                                  : "mirrors the first " + std::to_string(layers) +
+                                        " body layers behind face " + face + " with its ghosts";
+    const int axis = face[0] - 'x';
+    const double sign = face[1] == '-' ? -1.0 : 1.0;
+    const bool mirror = method != "fixed";
+    const bool quadratic = method == "mirror-quadratic";
+    const int rule = static_cast<int>(setup_.scene.prescriptions.size());
+    const double V = std::pow(setup_.dx, D);
+    Index ghosts = 0, fixedFallback = 0, oddFallback = 0;
+    Vec<D> thinAt = Vec<D>::Zero();
+    for (Index i = 0; i < bodyCount_; ++i) {
+      if (!onBoundingFace(i, face)) continue;
+      if (!mirror) clampHeld_.emplace(i, std::pair{name, holds});
+      for (long k = 1; k <= layers; ++k) {
+        // Ghost layer k is the lattice's cell k spacings outside X_i, exact on its grid.
+        const LatticeIndex cell = lattice_[axis].index(X[i][axis]) + (sign > 0 ? k : -k);
+        if (!lattice_[axis].holds(cell))
+          throw r.error("layers",
+                        std::to_string(layers) + " ghost layers reach beyond the lattice's range");
+        Vec<D> G = X[i];
+        G[axis] = lattice_[axis].coordinate(cell);
+        // Ghost layer k mirrors body layer k across the face (half a spacing outside X_i);
+        // the quadratic extrapolation also uses body layer k + 1 (MirrorGhost). Where the
+        // body is too thin behind the face (a wedge's tip), the ghost falls back to the
+        // odd reflection, or, with no body particle to mirror at all, is held as a fixed
+        // ghost that follows the clamp's motion.
+        MirrorGhost m;
+        bool mirrored = false;
+        if (mirror) {
+          auto behind = [&](long l) {
+            Vec<D> M = X[i];
+            M[axis] -= sign * (l - 1) * setup_.dx;
+            return latticeParticle(M);
+          };
+          m.mirror = behind(k);
+          mirrored = m.mirror >= 0;
+          if (mirrored) clampHeld_.emplace(m.mirror, std::pair{name, holds});
+          if (mirrored && quadratic) {
+            m.second = behind(k + 1);
+            if (m.second >= 0) clampHeld_.emplace(m.second, std::pair{name, holds});
+            if (m.second >= 0) {
+              // Lagrange extrapolation through u_p on the face, body layers k and k + 1.
+              m.w1 = -2.0 * k;
+              m.w2 = (2.0 * k - 1.0) * (2.0 * k - 1.0) / (2.0 * k + 1.0);
+            } else {
+              ++oddFallback;
+            }
+          }
+          if (!mirrored && fixedFallback++ == 0) thinAt = X[i];
+          m.motion = rule;
+        }
+        const std::uint16_t mat = p.material[i];
+        const Index g = p.add(G, V, density(setup_.scene.materials[mat]) * V, mat,
+                              mirrored ? Motion::Mirrored : Motion::Prescribed);
+        if (mirrored) {
+          m.ghost = g;
+          setup_.scene.mirrorGhosts.push_back(m);
+        } else {
+          clamp.particles.push_back(g);
+        }
+        setup_.body.push_back(setup_.body[i]);
+        setup_.ghost.push_back(1);
+        ++ghosts;
+      }
+    }
+    setup_.conditions.push_back("clamp." + name + ": face " + face + ", " + method + ", " +
+                                (motion == "fixed" ? "" : motion + " " + motionText(clamp) + ", ") +
+                                std::to_string(layers) + " ghost layers, " +
+                                std::to_string(ghosts) + " ghost particles");
+    if (fixedFallback > 0)
+      setup_.warnings.push_back(
+          config_.where("clamp." + name, "method") + ": [clamp." + name + "] " +
+          std::to_string(fixedFallback) + " of the " + std::to_string(ghosts) +
+          " ghosts have no body particle to mirror (the body is thinner than " +
+          std::to_string(layers) + " layers behind face " + face + ", e.g. behind " +
+          fmt<D>(thinAt) + "); they are held as fixed ghosts (method = fixed there), which " +
+          "puts u = 0 dx/2 outside the face at those points");
+    if (oddFallback > 0)
+      setup_.warnings.push_back(config_.where("clamp." + name, "method") + ": [clamp." + name +
+                                "] " + std::to_string(oddFallback) +
+                                " ghosts have no second body layer behind their mirror "
+                                "particle; they take the odd reflection (method = mirror)");
+    // A mirrored clamp's rule holds its fixed-ghost fallbacks only: the other ghosts follow
+    // it by reflection.
+    setup_.scene.prescriptions.push_back(std::move(clamp));
+  }
+}
+
+// The `motion` of a prescription or a clamp and its keys; returns the motion's name.
+template <int D>
+std::string Builder<D>::readMotion(SectionReader& r, Prescription<D>& rule) {
+  const std::string motion =
+      r.word("motion", "fixed", {"fixed", "velocity", "displacement", "rotation"});
+  rule.motion = motion == "fixed"          ? PrescribedMotion::Fixed
+                : motion == "velocity"     ? PrescribedMotion::Velocity
+                : motion == "displacement" ? PrescribedMotion::Displacement
+                                           : PrescribedMotion::Rotation;
+  if (rule.motion == PrescribedMotion::Rotation) {
+    // Rigid rotation about the axis through `point` at `rate` rad/s (times the ramp).
+    rule.axis = rotationAxis<D>(r);
+    rule.point = r.vector<D>("point");
+    rule.rate = r.number("rate");
+  } else if (rule.motion != PrescribedMotion::Fixed) {
+    rule.value = r.vector<D>("value");
+  }
+  rule.ramp.duration = r.nonNegative("ramp", 0.0);
+  if (rule.motion != PrescribedMotion::Rotation) r.allow({"value"});
+  return motion;
+}
+
+template <int D>
+std::string Builder<D>::motionText(const Prescription<D>& rule) {
+  return rule.motion == PrescribedMotion::Fixed ? ""
+         : rule.motion == PrescribedMotion::Rotation
+             ? rotationText<D>(rule.axis, rule.point, rule.rate)
+             : fmt<D>(rule.value);
+}
+
+template <int D>
+void Builder<D>::readPrescriptions() {
+  auto& p = setup_.scene.particles;
+  for (const auto& name : config_.namesOf("prescribe")) {
+    SectionReader r(config_, "prescribe." + name);
+    Prescription<D> rule;
+    rule.name = "prescribe." + name;
+    rule.particles = region(r);
+    const std::string motion = readMotion(r, rule);
+    r.finish();
+    for (Index i : rule.particles) {
+      if (const auto c = clampHeld_.find(i); c != clampHeld_.end())
+        throw r.error("region", "particle " + std::to_string(i) + " at " +
+                                    fmt<D>(p.referencePosition[i]) + " is held by [clamp." +
+                                    c->second.first + "], which " + c->second.second +
+                                    ": a particle cannot be both clamped and prescribed; keep "
+                                    "the region clear of them, or move the face with the "
+                                    "clamp's own motion");
+      if (p.motion[i] == Motion::Prescribed)
+        throw r.error("region", "particle " + std::to_string(i) + " at " +
+                                    fmt<D>(p.referencePosition[i]) +
+                                    " is already prescribed by another condition");
+      p.motion[i] = Motion::Prescribed;
+    }
+    const std::string what = rule.motion == PrescribedMotion::Fixed ? "" : motionText(rule) + " ";
+    setup_.conditions.push_back(rule.name + ": " + motion + " " + what + "on " +
+                                std::to_string(rule.particles.size()) + " particles");
+    setup_.scene.prescriptions.push_back(std::move(rule));
+  }
+}
+
+template void Builder<2>::addClamps();
+template std::string Builder<2>::readMotion(SectionReader&, Prescription<2>&);
+template std::string Builder<2>::motionText(const Prescription<2>&);
+template void Builder<2>::readPrescriptions();
+template void Builder<3>::addClamps();
+template std::string Builder<3>::readMotion(SectionReader&, Prescription<3>&);
+template std::string Builder<3>::motionText(const Prescription<3>&);
+template void Builder<3>::readPrescriptions();
+
+}  // namespace tlsph::scene_build

@@ -1,0 +1,115 @@
+// How the scene is solved: [kernel], [hourglass], [artificial_viscosity], [damping], [static]
+// and [time].
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
+#include "method/Kernel.hpp"
+#include "method/TimeStep.hpp"
+#include "scene/Builder.hpp"
+
+namespace tlsph::scene_build {
+
+template <int D>
+void Builder<D>::readDiscretisation() {
+  SectionReader k(config_, "kernel");
+  try {
+    setup_.scene.kernel =
+        parseKernelType(k.word("type", "wendland-c2", {"wendland-c2", "cubic-bspline"}));
+  } catch (const std::invalid_argument& e) {
+    throw k.error("type", e.what());
+  }
+  const double ratio = k.positive("support", 2.1);
+  if (ratio < 1.5 || ratio > 5.0)
+    throw k.error("support", "H/dx = " + fmt(ratio) + " is outside the useful range [1.5, 5]");
+  supportRatio_ = ratio;
+  setup_.scene.gradientCorrection =
+      parseGradientCorrection(k.word("correction", "quadratic", {"linear", "quadratic"}));
+  setup_.scene.supportRadius = ratio * setup_.dx;
+  // nodal = the one-point sum_I V_I psi(F_I); taylor adds its second-order term
+  // (TaylorQuadrature.hpp), the default where it can run: it needs the quadratic fit.
+  const bool quadratic = setup_.scene.gradientCorrection == GradientCorrection::Quadratic;
+  setup_.scene.quadrature =
+      parseQuadrature(k.word("quadrature", quadratic ? "taylor" : "nodal", {"nodal", "taylor"}));
+  if (setup_.scene.quadrature == Quadrature::Taylor && !quadratic)
+    throw k.error("quadrature",
+                  "taylor needs correction = quadratic (its second derivatives come from the "
+                  "quadratic fit)");
+  if (setup_.scene.quadrature == Quadrature::Taylor) warnNearlyIncompressible();
+  k.finish();
+  SectionReader h(config_, "hourglass");
+  setup_.scene.hourglassCoefficient = h.nonNegative("alpha", 10.0);
+  setup_.scene.hourglassForm =
+      parseHourglassForm(h.word("form", "energy", {"energy", "ganzenmueller"}));
+  setup_.scene.hourglassGradient =
+      parseHourglassGradient(h.word("gradient", "corrected", {"corrected", "linear"}));
+  h.finish();
+  SectionReader v(config_, "artificial_viscosity");
+  setup_.scene.viscosity.linear = v.nonNegative("linear", 0.0);
+  setup_.scene.viscosity.quadratic = v.nonNegative("quadratic", 0.0);
+  v.finish();
+}
+
+template <int D>
+void Builder<D>::readTimeAndDamping() {
+  SectionReader d(config_, "damping");
+  setup_.scene.damping.viscous = d.nonNegative("viscous", 0.0);
+  setup_.scene.damping.kinetic = d.flag("kinetic", false);
+  d.finish();
+  SectionReader s(config_, "static");
+  setup_.run.quasiStatic = s.flag("enabled", config_.hasSection("static"));
+  setup_.run.tolerance = s.positive("tolerance", 1e-5);
+  setup_.run.checkEvery = std::max(1L, s.integer("check_every", 50));
+  const bool newton = s.word("solver", "damped", {"damped", "newton"}) == "newton";
+  setup_.run.staticSolver =
+      newton ? RunSettings::StaticSolver::Newton : RunSettings::StaticSolver::Damped;
+  auto& n = setup_.run.newton;
+  n.tolerance = setup_.run.tolerance;
+  const long loadSteps = s.integer("load_steps", 1);
+  if (loadSteps < 1 || loadSteps > 100000)
+    throw s.error("load_steps",
+                  "must be between 1 and 100000, got " + config_.get("static", "load_steps"));
+  n.loadSteps = static_cast<int>(loadSteps);
+  const long iterations = s.integer("max_iterations", 30);
+  if (iterations < 1 || iterations > 100000)
+    throw s.error("max_iterations",
+                  "must be between 1 and 100000, got " + config_.get("static", "max_iterations"));
+  n.maxIterations = static_cast<int>(iterations);
+  const std::string preconditioner =
+      s.word("preconditioner", "auto", {"auto", "cholesky", "multigrid"});
+  n.preconditioner = preconditioner == "cholesky"    ? NewtonPreconditioner::Cholesky
+                     : preconditioner == "multigrid" ? NewtonPreconditioner::Multigrid
+                                                     : NewtonPreconditioner::Auto;
+  s.finish();
+  SectionReader t(config_, "time");
+  setup_.solver.cfl = t.positive("cfl", kDefaultCfl);
+  setup_.solver.timeStep = t.nonNegative("dt", 0.0);
+  // A Newton static run has no time to march; `end` only scales the default output interval.
+  setup_.run.endTime =
+      newton && setup_.run.quasiStatic ? t.positive("end", 1.0) : t.positive("end");
+  setup_.run.maxSteps = t.integer("max_steps", 0);
+  t.finish();
+  if (setup_.run.quasiStatic && newton && setup_.scene.hourglassCoefficient != 0.0 &&
+      setup_.scene.hourglassForm != HourglassForm::Energy)
+    throw InputError(config_.where("static", "solver"), "static", "solver",
+                     "solver = newton needs the hourglass penalty's energy form ([hourglass] "
+                     "form = energy): the textbook force (6.80)-(6.81) is not the gradient of "
+                     "an energy and has no symmetric tangent");
+  if (setup_.run.quasiStatic) {
+    if (!newton && !setup_.scene.damping.any())
+      throw InputError(config_.where("static", "enabled"), "static", "enabled",
+                       "a static run needs damping: set [damping] kinetic = true or viscous > 0, "
+                       "or solve it with [static] solver = newton");
+    if (setup_.scene.prescriptions.empty() && setup_.scene.mirrorGhosts.empty())
+      throw InputError(config_.where("static", "enabled"), "static", "enabled",
+                       "a static run needs the body held: add a [clamp.NAME] or a "
+                       "[prescribe.NAME] section, or it drifts away under its loads");
+  }
+}
+
+template void Builder<2>::readDiscretisation();
+template void Builder<2>::readTimeAndDamping();
+template void Builder<3>::readDiscretisation();
+template void Builder<3>::readTimeAndDamping();
+
+}  // namespace tlsph::scene_build

@@ -1,0 +1,143 @@
+// [output], [checkpoint], [guard] and [probe.NAME]: what a run writes, keeps and watches.
+#include <algorithm>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "geometry/LocalityOrder.hpp"
+#include "method/Kernel.hpp"
+#include "scene/Builder.hpp"
+
+namespace tlsph::scene_build {
+
+namespace {
+
+const std::vector<std::string> kFieldNames = {"displacement",    "velocity",      "J",
+                                              "von_mises",       "cauchy_stress", "first_piola",
+                                              "hourglass_error", "flags"};
+
+}  // namespace
+
+template <int D>
+void Builder<D>::readOutput() {
+  SectionReader o(config_, "output");
+  setup_.output.directory = o.word("directory", "output/" + setup_.name);
+  std::error_code status;
+  if (setup_.output.directory.empty())
+    throw o.error("directory", "must not be empty (give '.' for the working directory)");
+  if (std::filesystem::exists(setup_.output.directory, status) &&
+      !std::filesystem::is_directory(setup_.output.directory, status))
+    throw o.error("directory", "'" + setup_.output.directory + "' exists and is not a directory");
+  setup_.output.fields = o.words("fields", {"displacement", "velocity", "von_mises", "flags"});
+  if (setup_.output.fields.size() == 1 && setup_.output.fields[0] == "none")
+    setup_.output.fields.clear();
+  for (const auto& f : setup_.output.fields)
+    if (std::find(kFieldNames.begin(), kFieldNames.end(), f) == kFieldNames.end()) {
+      const std::string hint = closestMatch(f, kFieldNames);
+      std::string all;
+      for (const auto& n : kFieldNames)
+        all += (all.empty() ? "" : ", ") + n;
+      throw o.error("fields", "unknown field '" + f + "'" +
+                                  (hint.empty() ? "" : " (did you mean '" + hint + "'?)") +
+                                  "; fields: " + all + " (or 'none')");
+    }
+  setup_.output.everySteps = o.integer("every_steps", 0);
+  setup_.output.everyTime = o.nonNegative("every_time", 0.0);
+  if (setup_.output.everySteps == 0 && setup_.output.everyTime == 0.0)
+    setup_.output.everyTime = setup_.run.endTime / 20.0;
+  setup_.output.seriesEverySteps = std::max(1L, o.integer("series_every_steps", 20));
+  setup_.output.hourglassContent = o.flag("hourglass_content", false);
+  setup_.output.flushSeconds = o.nonNegative("flush_every_seconds", 10.0);
+  o.finish();
+}
+
+// Periodic checkpoints (app/CheckpointSchedule.hpp): by steps, by wall time, the last K kept.
+template <int D>
+void Builder<D>::readCheckpoint() {
+  SectionReader c(config_, "checkpoint");
+  setup_.checkpoint.everySteps = c.integer("every_steps", 0);
+  setup_.checkpoint.everySeconds = c.nonNegative("every_seconds", 600.0);
+  setup_.checkpoint.keep = c.integer("keep", 2);
+  if (setup_.checkpoint.keep < 1)
+    throw c.error("keep", "must be at least 1 (the newest checkpoint), got " +
+                              config_.get("checkpoint", "keep"));
+  c.finish();
+}
+
+// The run's stability guards (app/Guards.hpp), checked every [static] check_every steps.
+template <int D>
+void Builder<D>::readGuard() {
+  SectionReader g(config_, "guard");
+  setup_.guard.minJacobian = g.number("min_jacobian", 0.0);
+  if (!(setup_.guard.minJacobian >= 0.0 && setup_.guard.minJacobian < 1.0))
+    throw g.error("min_jacobian", "must be in [0, 1), got " + config_.get("guard", "min_jacobian"));
+  setup_.guard.energyError = g.nonNegative("energy_error", 0.05);
+  g.finish();
+}
+
+template <int D>
+void Builder<D>::readProbes() {
+  const auto& p = setup_.scene.particles;
+  const Kernel<D> kernel(setup_.scene.kernel, setup_.scene.supportRadius);
+  for (const auto& name : config_.namesOf("probe")) {
+    SectionReader r(config_, "probe." + name);
+    Probe<D> probe;
+    probe.name = name;
+    probe.point = r.vector<D>("point");
+    probe.method = r.word("method", "nearest", {"nearest", "kernel"}) == "nearest"
+                       ? ProbeMethod::Nearest
+                       : ProbeMethod::Kernel;
+    probe.quantities = r.words("quantities", {"displacement"});
+    for (const auto& q : probe.quantities)
+      if (q != "displacement" && q != "velocity" && q != "cauchy_stress")
+        throw r.error("quantities", "unknown quantity '" + q +
+                                        "'; expected displacement, velocity, cauchy_stress");
+    r.finish();
+    if (probe.method == ProbeMethod::Nearest) {
+      // Of equally near particles, the first in the lattice's order (latticeOrderBefore):
+      // the choice depends on the particles' places, not on their numbering.
+      const auto& X = p.referencePosition;
+      auto before = [&](Index i, Index j) {
+        const double di = (X[i] - probe.point).squaredNorm(),
+                     dj = (X[j] - probe.point).squaredNorm();
+        if (di != dj) return di < dj;
+        return latticeOrderBefore<D>(X[i], X[j]);
+      };
+      Index best = 0;
+      for (Index i = 1; i < bodyCount_; ++i)
+        if (before(i, best)) best = i;
+      probe.particles = {best};
+      probe.weights = {1.0};
+    } else {
+      // Shepard-normalised kernel interpolation over the reference neighbourhood; each
+      // particle's displacement is carried to the point with its own gradient F - 1, so the
+      // probe is exact for linear fields even on the surface (a beam's tip).
+      double sum = 0.0;
+      for (Index i = 0; i < bodyCount_; ++i) {
+        const double w = kernel.value((p.referencePosition[i] - probe.point).norm()) * p.volume[i];
+        if (w > 0.0) {
+          probe.particles.push_back(i);
+          probe.weights.push_back(w);
+          probe.offsets.push_back(probe.point - p.referencePosition[i]);
+          sum += w;
+        }
+      }
+      if (probe.particles.empty())
+        throw r.error("point", "no particle within the kernel support of " + fmt<D>(probe.point));
+      for (double& w : probe.weights)
+        w /= sum;
+    }
+    setup_.probes.push_back(std::move(probe));
+  }
+}
+
+template void Builder<2>::readOutput();
+template void Builder<2>::readCheckpoint();
+template void Builder<2>::readGuard();
+template void Builder<2>::readProbes();
+template void Builder<3>::readOutput();
+template void Builder<3>::readCheckpoint();
+template void Builder<3>::readGuard();
+template void Builder<3>::readProbes();
+
+}  // namespace tlsph::scene_build
