@@ -3,6 +3,11 @@
 // plain reference evaluation (method/PairForces.hpp), for every combination of terms a scene
 // can ask for, on a jittered 2D and 3D block of two materials with a mirrored ghost layer:
 // F to 1e-13, the force to 1e-12 of its largest value, the energies to 1e-12.
+// The combinations reach every fast path: the internal force summed from its sources
+// (InternalForceScatter, 512-bit interleaved records where compiled) when it is the only pair
+// term or carries the energy penalty on the same F, gathered otherwise; in 3D the two-particle
+// padded sums of the F pass (the Taylor fit's, and the nodal one when the penalty reads F);
+// the penalty's own linear F beside the quadratic one; passive particles in their own group.
 #include <gtest/gtest.h>
 
 #include <algorithm>
