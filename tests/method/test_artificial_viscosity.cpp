@@ -1,4 +1,5 @@
-// Artificial viscosity (6.77) in its total-Lagrangian pair form: central and antisymmetric pair
+// Artificial viscosity (6.77) in its total-Lagrangian pair form, on the plain loops
+// (method/PairForces.hpp): central and antisymmetric pair
 // forces (linear and angular momentum conserved), zero for rigid motion and for separating
 // pairs, never a source of energy; in a run its work is booked as damping and the books
 // balance; off means not computed.
@@ -6,6 +7,7 @@
 
 #include "TestSupport.hpp"
 #include "explicit/Solver.hpp"
+#include "method/PairForces.hpp"
 
 using namespace tlsph;
 using namespace tlsph::testing;
@@ -19,7 +21,7 @@ struct ViscousCase {
   std::mt19937 rng;
   Scene<D> scene;
   ReferenceConfiguration<D> ref;
-  TlsphForces<D> forces;
+  PairForces<D> forces;
   explicit ViscousCase(std::uint32_t seed, ViscositySettings q = {1.0, 2.0})
       : rng(seed),
         scene(sceneOf<D>(perturbedBlock<D>(counts(), kDx, 0.2, rng), kDx, 2.5,

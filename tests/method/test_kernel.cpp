@@ -3,8 +3,8 @@
 
 #include <random>
 
-#include "method/Kernel.hpp"
 #include "geometry/Lattice.hpp"
+#include "method/Kernel.hpp"
 
 using namespace tlsph;
 

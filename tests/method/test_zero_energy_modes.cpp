@@ -1,12 +1,13 @@
 // Zero-energy modes (chapter section 6.13): the null space of the discrete stiffness
-// K = -df/du at u = 0. On a periodic lattice the uncorrected scheme has spurious exact
-// zero modes that the hourglass penalty removes; on a free block only rigid-body modes are
-// exact zeros, and the spurious modes survive as low-energy modes.
+// K = -df/du at u = 0 of the plain evaluation (method/PairForces.hpp). On a periodic lattice
+// the uncorrected scheme has spurious exact zero modes that the hourglass penalty removes; on a
+// free block only rigid-body modes are exact zeros, and the spurious modes survive as
+// low-energy modes.
 #include <gtest/gtest.h>
 
 #include <Eigen/SVD>
 
-#include "TestSupport.hpp"
+#include "PlainEvaluator.hpp"
 
 using namespace tlsph;
 using namespace tlsph::testing;
@@ -18,7 +19,7 @@ constexpr double kDx = 0.01;
 // -df/du by central differences, Richardson-extrapolated: exact for the linear internal force,
 // O(s^4) for the hourglass term (nonlinear through x_IJ / |x_IJ|).
 template <int D>
-Eigen::MatrixXd stiffness(ForceEvaluator<D>& eval) {
+Eigen::MatrixXd stiffness(PlainEvaluator<D>& eval) {
   const Index n = eval.size() * D;
   auto centralDifference = [&](double s) {
     Eigen::MatrixXd K(n, n);
@@ -65,7 +66,7 @@ Spectrum latticeSpectrum(int cellsPerAxis, bool periodic, double supportRatio, d
     scene.periodicBox.periodic.fill(true);
     scene.periodicBox.length = Vec<D>::Constant(cellsPerAxis * kDx);
   }
-  ForceEvaluator<D> eval(std::move(scene));
+  PlainEvaluator<D> eval(std::move(scene));
   return spectrum(stiffness(eval));
 }
 

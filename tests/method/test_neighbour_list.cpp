@@ -4,8 +4,8 @@
 #include <algorithm>
 #include <random>
 
-#include "model/Errors.hpp"
 #include "method/NeighbourList.hpp"
+#include "model/Errors.hpp"
 
 using namespace tlsph;
 
