@@ -1,7 +1,7 @@
-// What the solver needs from a distributed run (issue 11), without depending on MPI: the
+// What the solver needs from a distributed run, without depending on MPI: the
 // particles are split among ranks once (DomainPartition); each rank advances its own ones and
 // reads a halo of its neighbours' from their owners. The MPI implementation is
-// parallel/MpiCommunicator; a serial run has none (a null Communicator*).
+// distributed/MpiCommunicator; a serial run has none (a null Communicator*).
 //
 // Arrays stay indexed by global particle on every rank: a rank computes its own entries,
 // exchangeHalo() brings the entries its particles read (one neighbour layer), gatherAll() every

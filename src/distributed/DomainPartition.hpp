@@ -1,4 +1,4 @@
-// The particles split among the ranks of a distributed run, once, at set-up (issue 11): in a
+// The particles split among the ranks of a distributed run, once, at set-up: in a
 // total-Lagrangian code the neighbour graph never changes, so one partition and one halo plan
 // serve the whole run. Each part owns its particles and reads a halo of one neighbour layer
 // from the others: the step reads neighbours' displacements (the F pass) and their stresses

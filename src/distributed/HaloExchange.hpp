@@ -1,4 +1,4 @@
-// The static communication plan of one MPI rank (issue 11), built once from the partition:
+// The static communication plan of one MPI rank, built once from the partition:
 // what it receives from each neighbour rank (its halo, the particles of other ranks its own
 // particles read) and what it sends (its particles in their halos), both in ascending global
 // index on either side, so no index travels. One exchange is one MPI neighbourhood

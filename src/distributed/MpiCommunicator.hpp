@@ -1,4 +1,4 @@
-// The Communicator of a distributed run over MPI (issue 11): the halo exchange of
+// The Communicator of a distributed run over MPI: the halo exchange of
 // HaloExchange, the gather of every rank's particles (MPI_Allgatherv of the owned entries),
 // reductions and broadcasts on the communicator given.
 #pragma once
@@ -8,8 +8,8 @@
 #include <memory>
 #include <vector>
 
-#include "distributed/HaloExchange.hpp"
 #include "distributed/Communicator.hpp"
+#include "distributed/HaloExchange.hpp"
 
 namespace tlsph {
 

@@ -1,6 +1,6 @@
 // A sum whose bits depend only on the values summed, not on their order nor on how they are
-// split among threads or ranks (issue 11: a decision the trajectory depends on, kinetic
-// damping's peak test, must come out the same on any number of ranks).
+// split among threads or ranks: a decision the trajectory depends on (kinetic damping's peak
+// test) must come out the same on any number of ranks.
 //
 // Pre-rounding in three levels (after Rump, Ogita and Oishi's error-free extraction): with
 // m = max |x_i| and n values, sigma = 2^k >= 2 n m; q_i = (sigma + x_i) - sigma is exact and a

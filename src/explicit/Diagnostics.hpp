@@ -7,10 +7,10 @@
 #include <span>
 #include <vector>
 
-#include "execution/OrderedSum.hpp"
-#include "model/Particles.hpp"
-#include "method/ReferenceConfiguration.hpp"
 #include "distributed/ReproducibleSum.hpp"
+#include "execution/OrderedSum.hpp"
+#include "method/ReferenceConfiguration.hpp"
+#include "model/Particles.hpp"
 #include "model/Types.hpp"
 
 namespace tlsph {

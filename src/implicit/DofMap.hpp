@@ -3,7 +3,7 @@
 //   prescribed particles: u = u_p(t), no unknown;
 //   mirrored ghosts:      u_g = d_g(t) + w1 u_1 + w2 u_2  (MirrorGhost).
 // So a variation of the full displacement vector is T dv, with T this map's linear part, and
-// the forces on the unknowns are T^T f (the chain rule that Solver::chainMirrorForces applies).
+// the forces on the unknowns are T^T f (the chain rule that MirroredGhosts::chainForces applies).
 #pragma once
 
 #include <Eigen/Core>

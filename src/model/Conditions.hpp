@@ -124,8 +124,11 @@ Vec<D> prescribedDisplacementAt(const Prescription<D>& rule, const Vec<D>& X, do
   return Vec<D>::Zero();
 }
 
+// Prescribed velocity of a rule at a point now at x: the one switch over the rules' velocities,
+// for the solver's prescribed particles (at their own positions) and the mirrored faces (at
+// their points' prescribed positions). Only a rotation's velocity depends on where the point is.
 template <int D>
-Vec<D> prescribedVelocityAt(const Prescription<D>& rule, const Vec<D>& X, double t) {
+Vec<D> prescribedVelocityAtPosition(const Prescription<D>& rule, const Vec<D>& x, double t) {
   switch (rule.motion) {
     case PrescribedMotion::Fixed:
       return Vec<D>::Zero();
@@ -134,11 +137,19 @@ Vec<D> prescribedVelocityAt(const Prescription<D>& rule, const Vec<D>& X, double
     case PrescribedMotion::Displacement:
       return rule.value * rule.ramp.rate(t);
     case PrescribedMotion::Rotation: {
-      const Vec<D> r = X + prescribedDisplacementAt(rule, X, t) - rule.point;
+      const Vec<D> r = x - rule.point;
       return rotationVelocity<D>(rule.axis, rule.rate * rule.ramp.factor(t), r);
     }
   }
   return Vec<D>::Zero();
+}
+
+// At a reference point X that follows the rule from zero displacement (a mirrored face's).
+template <int D>
+Vec<D> prescribedVelocityAt(const Prescription<D>& rule, const Vec<D>& X, double t) {
+  if (rule.motion != PrescribedMotion::Rotation) return prescribedVelocityAtPosition(rule, X, t);
+  const Vec<D> x = X + prescribedDisplacementAt(rule, X, t);
+  return prescribedVelocityAtPosition(rule, x, t);
 }
 
 struct Damping {

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""A distributed run is the serial run, bit for bit (issue 11).
+"""A distributed run is the serial run, bit for bit.
 
 For each scene below (2D and 3D, covering the clamps' mirrored ghosts, moving clamps,
 prescribed rotation, loads, gravity, probes, kinetic damping with the static stop, artificial

@@ -1,4 +1,4 @@
-// Splitting the particles among ranks (DomainPartition, issue 11): every particle owned once,
+// Splitting the particles among ranks (DomainPartition): every particle owned once,
 // the halo exactly the other parts' particles that the owned ones read, the parts balanced,
 // the same partition on every call, and of the two partitioners the one with the smaller halo
 // kept.

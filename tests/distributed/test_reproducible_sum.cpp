@@ -1,4 +1,4 @@
-// The order-independent sum (ReproducibleSum.hpp, issue 11): the same bits for any order and
+// The order-independent sum (ReproducibleSum.hpp): the same bits for any order and
 // any split of the values into parts (the ranks of a distributed run), accurate to a few ulps
 // of the exact sum even under cancellation, and NaN / inf / zero passed through.
 #include <gtest/gtest.h>

@@ -1,11 +1,14 @@
-// The mirrored clamp (docs/method.md section 3): ghosts take the odd reflection u_ghost = -u_mirror of
-// the body particle mirrored across the face, carry no strain energy, and send their force back to
-// the mirror particle. Then the force on the body is -dE/du of the body's energy (strain plus
+// The mirrored clamp (docs/method.md section 3): ghosts take the odd reflection u_ghost = -u_mirror
+// of the body particle mirrored across the face, carry no strain energy, and send their force back
+// to the mirror particle. Then the force on the body is -dE/du of the body's energy (strain plus
 // hourglass), an undamped run keeps its energy books balanced, and a field that vanishes on the
-// face with odd symmetry is reproduced exactly by the ghosts.
+// face with odd symmetry is reproduced exactly by the ghosts. Then MirroredGhosts piece by
+// piece: the checks of the ghost list, the extrapolation, the drive of a moving face, the
+// chain rule and the reaction's ghost part.
 #include <gtest/gtest.h>
 
 #include "TestSupport.hpp"
+#include "explicit/MirroredGhosts.hpp"
 #include "explicit/Solver.hpp"
 
 using namespace tlsph;
@@ -337,4 +340,149 @@ TEST(MirroredClamp, MovingFaceKeepsTheEnergyBooks) {
     EXPECT_LT(b.error, 1e-3);
     EXPECT_LT(half.error, b.error / 3.0);
   }
+}
+
+namespace {
+
+// A line of particles along x: ghost g at -0.5 mirrors body particle 1 at 0.5 across the face
+// x = 0, with particle 2 at 1.5 the next one inward (quadratic extrapolation weights), and a
+// second ghost at -1.5 that follows particle 2 only (odd reflection). The face follows
+// prescription 0 when `moving`.
+Scene<2> ghostLine(bool moving) {
+  Scene<2> scene;
+  auto& p = scene.particles;
+  p.add(Vec<2>(0.5, 0.0), 1.0, 1.0, 0);                     // 0: mirror particle 1
+  p.add(Vec<2>(1.5, 0.0), 1.0, 1.0, 0);                     // 1: particle 2
+  p.add(Vec<2>(-0.5, 0.0), 1.0, 1.0, 0, Motion::Mirrored);  // 2: ghost of 0 (and 1)
+  p.add(Vec<2>(-1.5, 0.0), 1.0, 1.0, 0, Motion::Mirrored);  // 3: ghost of 1
+  Prescription<2> face;
+  face.name = "face";
+  face.motion = PrescribedMotion::Velocity;
+  face.value = Vec<2>(0.0, 0.2);
+  face.ramp.duration = 1.0;
+  scene.prescriptions.push_back(face);
+  MirrorGhost a;
+  a.ghost = 2;
+  a.mirror = 0;
+  a.w1 = -2.0;
+  a.second = 1;
+  a.w2 = 1.0 / 3.0;
+  a.motion = moving ? 0 : -1;
+  MirrorGhost b;
+  b.ghost = 3;
+  b.mirror = 1;
+  b.motion = moving ? 0 : -1;
+  scene.mirrorGhosts = {a, b};
+  p.displacement[0] = Vec<2>(0.01, 0.02);
+  p.displacement[1] = Vec<2>(-0.03, 0.05);
+  p.velocity[0] = Vec<2>(1.0, -2.0);
+  p.velocity[1] = Vec<2>(0.5, 0.25);
+  return scene;
+}
+
+}  // namespace
+
+TEST(MirroredGhosts, GhostListIsChecked) {
+  EXPECT_EQ(MirroredGhosts<2>::checkedGhostList(ghostLine(false)), (std::vector<Index>{2, 3}));
+  Scene<2> orphan = ghostLine(false);
+  orphan.mirrorGhosts.pop_back();  // particle 3 is mirrored with no mirror
+  EXPECT_THROW(MirroredGhosts<2>::checkedGhostList(orphan), SetupError);
+  Scene<2> ghostOfGhost = ghostLine(false);
+  ghostOfGhost.mirrorGhosts[1].mirror = 2;  // follows a ghost, not a free particle
+  EXPECT_THROW(MirroredGhosts<2>::checkedGhostList(ghostOfGhost), SetupError);
+  Scene<2> noRule = ghostLine(true);
+  noRule.mirrorGhosts[0].motion = 1;  // there is one prescription only
+  EXPECT_THROW(MirroredGhosts<2>::checkedGhostList(noRule), SetupError);
+}
+
+// A fixed face: the ghosts are the weighted sums of the body particles they follow, in
+// displacement and in velocity; no drive.
+TEST(MirroredGhosts, FixedFaceGhostsExtrapolateTheBody) {
+  Scene<2> scene = ghostLine(false);
+  const MirroredGhosts<2> ghosts(scene);
+  EXPECT_FALSE(ghosts.moving());
+  auto& p = scene.particles;
+  ghosts.move(p);
+  EXPECT_LT((p.displacement[2] - (-2.0 * p.displacement[0] + p.displacement[1] / 3.0)).norm(),
+            1e-16);
+  EXPECT_LT((p.velocity[2] - (-2.0 * p.velocity[0] + p.velocity[1] / 3.0)).norm(), 1e-15);
+  EXPECT_EQ(p.displacement[3], -p.displacement[1]);
+  EXPECT_EQ(p.velocity[3], -p.velocity[1]);
+}
+
+// A moving face: each ghost adds the drive d_g = u_p(X_g) - w1 u_p(X_1) - w2 u_p(X_2), so a
+// body in the face's own motion is extended exactly; the drive's change over a step is what
+// the face's work is booked on.
+TEST(MirroredGhosts, MovingFaceDrivesTheGhosts) {
+  Scene<2> scene = ghostLine(true);
+  MirroredGhosts<2> ghosts(scene);
+  EXPECT_TRUE(ghosts.moving());
+  auto& p = scene.particles;
+  const auto& rule = scene.prescriptions[0];
+  const double t = 0.4;
+  ghosts.updateDrive(t);
+  for (Index i : {0, 1}) {  // the body in the face's motion
+    p.displacement[i] = prescribedDisplacementAt(rule, p.referencePosition[i], t);
+    p.velocity[i] = prescribedVelocityAt(rule, p.referencePosition[i], t);
+  }
+  ghosts.move(p);
+  for (Index g : {2, 3}) {
+    EXPECT_LT(
+        (p.displacement[g] - prescribedDisplacementAt(rule, p.referencePosition[g], t)).norm(),
+        1e-15)
+        << g;
+    EXPECT_LT((p.velocity[g] - prescribedVelocityAt(rule, p.referencePosition[g], t)).norm(), 1e-15)
+        << g;
+  }
+  // A translation: u_p is the same everywhere, so d = (1 - w1 - w2) u_p.
+  const auto before = ghosts.drive();
+  const auto change = ghosts.advanceDrive(0.6);
+  ASSERT_EQ(change.size(), 2u);
+  const Vec<2> du = prescribedDisplacementAt<2>(rule, Vec<2>::Zero(), 0.6) -
+                    prescribedDisplacementAt<2>(rule, Vec<2>::Zero(), t);
+  EXPECT_LT((change[0] - (1.0 + 2.0 - 1.0 / 3.0) * du).norm(), 1e-15);
+  EXPECT_LT((change[1] - 2.0 * du).norm(), 1e-15);
+  EXPECT_LT((ghosts.drive()[1] - before[1] - change[1]).norm(), 1e-17);
+  // A static state holds the faces still.
+  ghosts.holdDriveAt(0.6);
+  ghosts.move(p);
+  EXPECT_LT((p.velocity[3] + p.velocity[1]).norm(), 1e-15);
+  // A fixed face has no drive to change.
+  const Scene<2> still = ghostLine(false);
+  MirroredGhosts<2> fixed(still);
+  EXPECT_TRUE(fixed.advanceDrive(0.6).empty());
+}
+
+// The chain rule sends w1 and w2 of each ghost's force to the particles it follows; the rest,
+// (1 - w1 - w2) f_ghost, is what the face takes: the reaction's ghost part, so that body and
+// reaction together hold the ghost's whole force.
+TEST(MirroredGhosts, ChainRuleAndReactionShareTheGhostForce) {
+  Scene<2> scene = ghostLine(true);
+  const MirroredGhosts<2> ghosts(scene);
+  std::vector<Vec<2>> f = {Vec<2>(1.0, 2.0), Vec<2>(-3.0, 0.5), Vec<2>(0.25, -1.0),
+                           Vec<2>(4.0, 3.0)};
+  const std::vector<Vec<2>> before = f;
+  ghosts.chainForces(f);
+  EXPECT_EQ(f[0], before[0] - 2.0 * before[2]);
+  EXPECT_LT((f[1] - (before[1] + before[2] / 3.0 - before[3])).norm(), 1e-15);
+  EXPECT_EQ(f[2], before[2]);  // the ghost keeps its own force
+  Vec<2> R = Vec<2>::Zero();
+  ghosts.addReaction(0, f, R);
+  const Vec<2> body = (f[0] - before[0]) + (f[1] - before[1]);
+  EXPECT_LT((body - R - (before[2] + before[3])).norm(), 1e-14);
+  Vec<2> none = Vec<2>::Zero();
+  ghosts.addReaction(1, f, none);
+  EXPECT_EQ(none, Vec<2>::Zero());
+}
+
+TEST(MirroredGhosts, ARankKeepsTheGhostsOfItsParticles) {
+  Scene<2> scene = ghostLine(false);
+  MirroredGhosts<2> ghosts(scene);
+  EXPECT_EQ(ghosts.own(), (std::vector<std::size_t>{0, 1}));
+  ghosts.keepOwn({1, 1, 0, 1});
+  EXPECT_EQ(ghosts.own(), (std::vector<std::size_t>{1}));
+  std::vector<Vec<2>> f(4, Vec<2>(1.0, 1.0));
+  ghosts.chainForces(f);
+  EXPECT_EQ(f[0], Vec<2>(1.0, 1.0));  // ghost 0 is another rank's
+  EXPECT_EQ(f[1], Vec<2>(0.0, 0.0));
 }
