@@ -1,4 +1,4 @@
-// Storage for the arrays the pair loops stream every step (issue 12): the per-pair arrays
+// Storage for the arrays the pair loops stream every step: the per-pair arrays
 // and the per-particle ones they gather at the neighbours' indices. A block of 2 MiB or more
 // is mapped on its own, aligned to 2 MiB and advised for transparent huge pages before it is
 // first touched, so the kernel backs it with 2 MiB pages where it can.

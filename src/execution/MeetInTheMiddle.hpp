@@ -1,5 +1,5 @@
 // A pass's particles shared among the threads two by two, each pair finishing together however
-// the host slows either core (issue 12, docs/performance.md). Every pair of threads holds the
+// the host slows either core (docs/performance.md). Every pair of threads holds the
 // static shares of its two threads, [count 2k / T, count (2k + 2) / T); its first thread takes
 // chunks of it from the bottom upwards, its second from the top downwards, until they meet.
 // Each takes a quarter of what is left (at least kMinChunk particles), so a pair makes a few
@@ -47,8 +47,8 @@ class MeetInTheMiddle {
   }
 
   // Inside the region, one per thread: the chunks [a, b) it computes, one after the other.
-  // (The passes write this loop out: a helper taking the pass's body as a lambda measured
-  // 10-13 % slower, paired, one thread; GCC compiled the body worse.)
+  // (The passes write this loop out: GCC compiled a helper taking the pass's body as a lambda
+  // 10-13 % slower.)
   // From split (reset() for this pass) when given, else the thread's static share.
   class Chunks {
    public:

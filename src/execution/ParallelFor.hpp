@@ -3,7 +3,7 @@
 // from and meet near (MeetInTheMiddle.hpp). Each thread then mostly writes the particles whose
 // cache lines its core already holds: on two threads a
 // per-particle array written by one thread alone moved half its lines between the cores every
-// step (issue 12, docs/performance.md).
+// step (docs/performance.md).
 #pragma once
 
 #include "model/Types.hpp"

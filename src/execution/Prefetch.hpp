@@ -1,15 +1,12 @@
-// Software prefetch for the pair loops' per-pair streams (issue 12).
+// Software prefetch for the pair loops' per-pair streams and gathers.
 //
 // Each pass reads its per-pair records (the fit [g_IJ, S_IJ], the reverse vectors, X_IJ, c_IJ)
 // front to back, a particle's row of about 26-30 records at a time, while it gathers the
 // neighbours' values from cache. The hardware prefetchers alone left the passes waiting on
-// these streams both out of cache and from L3; asking for the line a fixed distance ahead,
-// once per record, measured +34-46 % per step at 41,728 particles and +0.5-14 % at 5,312 (both
-// corrections, 1 and 2 threads, Intel Xeon model 167), with a broad optimum at 1.5-2 KB ahead
-// (tried 0.5-6 KB): about one particle's row of the widest (72 B) record. docs/performance.md
-// has the tables. That was before rows were shared (SharedRows.hpp): a pass now asks only where
-// its rows stream (SharedRows::streams); the beam's shared rows, read mostly from cache, ran
-// 1-4 % faster without it, rows off the lattice 20-30 % slower (Zen 5).
+// these streams; asking for the line a fixed distance ahead, once per record, gives +34-46 % per
+// step on unshared rows, best at 1.5-2 KB ahead (about one particle's row of the widest, 72 B,
+// record; docs/performance.md). Shared rows (SharedRows.hpp), read mostly from cache, run faster
+// without it, so a pass asks only where its rows stream (SharedRows::streams).
 #pragma once
 
 #include <cstddef>
@@ -36,9 +33,9 @@ inline void prefetchAhead(const T* p) {
 // On a lattice particle i + 1's neighbours are mostly particle i's shifted by one, so the lines
 // a particle kGatherAhead further on will read at this pair's position are those of value
 // j + kGatherAhead. Out of cache the hardware prefetchers do not follow the several dozen
-// streams this makes (one per stencil row and array): asking for them measured +17-39 % on one
-// and two threads at 10^6 particles on an AMD EPYC Zen 4 (the defaults), but 7-9 % slower
-// when the arrays sit in the last-level cache, hence only then (gathersFromMemory).
+// streams this makes (one per stencil row and array): asking for them gives +17-39 % at 10^6
+// particles but costs 7-9 % when the arrays sit in the last-level cache, hence only where they
+// do not (gathersFromMemory).
 inline constexpr std::intptr_t kGatherAhead = 8;
 
 // Asks for every cache line of value j + kGatherAhead of the per-particle array a (a hint,
@@ -63,8 +60,8 @@ std::size_t lastLevelCacheBytes();
 // "32768K", "1M", "512": a cache size as /sys writes it, in bytes (0 when unreadable).
 std::size_t parseCacheSize(const std::string& text);
 // True when arrays of this many bytes, gathered by the pair loops, are read from memory rather
-// than from the last-level cache (more than twice its size: measured between 1x, still 7 %
-// slower with the prefetch, and 3x, 10 % faster).
+// than from the last-level cache (more than twice its size: the prefetch's break-even lies
+// between once and three times).
 inline bool gathersFromMemory(double gatheredBytes) {
   return gatheredBytes > 2.0 * static_cast<double>(lastLevelCacheBytes());
 }

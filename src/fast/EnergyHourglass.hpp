@@ -1,5 +1,6 @@
-// The hourglass penalty as an energy (docs/method.md section 2; the conservative form of
-// Ganzenmueller's (6.80)-(6.81)):
+// E_hg and its gradient, as method/HourglassEnergy.hpp, in one pass over the pairs (shared
+// rows, padded in 3D): the hourglass penalty as an energy (docs/method.md section 2; the
+// conservative form of Ganzenmueller's (6.80)-(6.81)):
 //   E_hg = 1/4 sum_I sum_J k_IJ |e_IJ|^2,   e_IJ = x_IJ - 1/2 (F_I + F_J) X_IJ,   k_IJ = V_I c_IJ.
 // Its exact gradient has two parts: the spring  -sum_J k_IJ e_IJ  on I, and, through F, an
 // "hourglass stress"  P^hg_I = -1/2 sum_J c_IJ e_IJ (x) X_IJ  that the internal-force pass sends
@@ -12,12 +13,12 @@
 #include <utility>
 #include <vector>
 
-#include "execution/MeetInTheMiddle.hpp"
-#include "fast/Padded.hpp"
-#include "execution/Prefetch.hpp"
-#include "method/ReferenceConfiguration.hpp"
 #include "distributed/ReproducibleSum.hpp"
+#include "execution/MeetInTheMiddle.hpp"
+#include "execution/Prefetch.hpp"
+#include "fast/Padded.hpp"
 #include "fast/SharedRows.hpp"
+#include "method/ReferenceConfiguration.hpp"
 #include "model/Types.hpp"
 
 namespace tlsph {

@@ -1,5 +1,5 @@
-// The internal force (6.70), with the Taylor quadrature's hyperstress force, summed from its
-// sources (issue 12):
+// The internal force (6.70), as method/InternalForce.hpp, with the Taylor quadrature's
+// hyperstress force (method/TaylorCorrection.hpp), summed from its sources:
 //   f_I = V_I (S_I G_I + R_I . Sum_I - sum_J [S_J t_IJ + R_J . T_IJ])
 // The gather form (TlsphForces::accumulateForces) loads the neighbour's S_J and R_J at every
 // pair: in 3D nine padded columns per pair, which bound that pass out of the first cache
@@ -24,10 +24,9 @@
 // (S_0e S_0e S_1e S_1e ...) times one entry of both records (a 128-bit load, repeated), the
 // rows of the two targets' terms side by side. Each lane is the one-pair product's lane, the
 // same multiply-adds in the same order: the same bits. Half the multiply-adds and record loads
-// of pair by pair, for three shuffles per two pairs (the two targets' sums in and out); +3-8 %
-// per step at the defaults, +3-4 % linear/nodal (Zen 5, docs/performance.md). Without AVX-512
-// the records stay one after the other: pair by pair, reading them every other entry would
-// only cost (0.91-0.95x measured for the unpadded P that way).
+// of pair by pair, for three shuffles per two pairs (the two targets' sums in and out): +3-8 %
+// per step at the defaults. Without AVX-512 the records stay one after the other: pair by
+// pair, reading them every other entry would only cost (5-9 % slower for the unpadded P).
 #pragma once
 
 #include <algorithm>
@@ -43,12 +42,12 @@
 
 #include "execution/LargePageAllocator.hpp"
 #include "execution/MeetInTheMiddle.hpp"
-#include "method/NeighbourList.hpp"
-#include "fast/Padded.hpp"
 #include "execution/Prefetch.hpp"
+#include "execution/Threads.hpp"
+#include "fast/Padded.hpp"
 #include "fast/SharedRows.hpp"
 #include "fast/TaylorQuadrature.hpp"
-#include "execution/Threads.hpp"
+#include "method/NeighbourList.hpp"
 #include "model/Types.hpp"
 
 namespace tlsph {

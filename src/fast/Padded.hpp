@@ -1,7 +1,7 @@
-// The pair loops' gathered values with their 3-vectors padded to 4 doubles (issue 12).
-// A column of a padded 3 x C matrix is one 256-bit register, so S_J t_IJ, R_J T_IJ, F_J X_IJ
-// and w_IJ X_IJ^T are one vector multiply-add per column instead of a 2-wide and a scalar one
-// (Zen 4, defaults, 5,312 particles: 20 % fewer cycles per step). The fourth row is zero and
+// No formula of method/: the pair loops' gathered values with their 3-vectors padded to 4
+// doubles. A column of a padded 3 x C matrix is one 256-bit register, so S_J t_IJ, R_J T_IJ,
+// F_J X_IJ and w_IJ X_IJ^T are one vector multiply-add per column instead of a 2-wide and a
+// scalar one (20 % fewer cycles per step). The fourth row is zero and
 // stays zero: only the top D rows are ever written (topRows()). In 2D nothing is padded: a
 // padded type is the plain one.
 #pragma once
@@ -35,7 +35,7 @@ PaddedMat<D, C> padded(const Eigen::Matrix<double, D, C>& m) {
 // The top D x D of m transposed, with a zero fourth row (m's must be zero too). In 3D with AVX
 // this stays in registers (seven shuffles): Eigen's transpose assembles the columns on the stack
 // from 64-bit stores, and reloading them as 256-bit words stalls store-to-load forwarding
-// (measured in TaylorQuadrature's stresses, issue 12).
+// (measured in TaylorQuadrature's stresses).
 template <int D>
 PaddedMat<D, D> transposed(const PaddedMat<D, D>& m) {
 #ifdef __AVX__
@@ -64,7 +64,7 @@ PaddedMat<D, D> transposed(const PaddedMat<D, D>& m) {
 // put together in a register (its entries wherever GCC holds them), added to s's as one 256-bit
 // word and stored as one: written with Eigen, GCC moved such sums through the stack in 16- and
 // 8-byte pieces and reloaded them as 256-bit words, stalling store-to-load forwarding (the
-// Taylor F pass, issue 12). The same sums, the same bits.
+// Taylor F pass). The same sums, the same bits.
 template <int D>
 void addTop(const PaddedMat<D, D>& s, const Mat<D>& m, PaddedMat<D, D>& out) {
 #ifdef __AVX__

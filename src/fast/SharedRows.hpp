@@ -1,4 +1,5 @@
-// Per-pair values stored once per distinct particle row (issue 12).
+// No formula of method/: per-pair values stored once per distinct particle row, read by the
+// fast passes where the plain loops of method/ read the whole per-pair arrays.
 //
 // A per-pair array holds, for particle I, the row of its pairs' values a_IJ over its neighbour
 // list. On a lattice many particles see the same neighbourhood to the last bit (same offsets,
@@ -72,8 +73,8 @@ class SharedRows {
   // the particles' rows start where the previous particle's ended (all of them when no row is
   // shared). Only then does asking for the line ahead (prefetchAhead) pay: shared rows jump
   // back to a row read before, mostly still in cache, and the line ahead is one no particle
-  // needs soon (measured: +34-46 % per step with unshared rows, 1-3 % slower with the beam's
-  // shared ones; docs/performance.md).
+  // needs soon (+34-46 % per step with unshared rows, 1-3 % slower with the beam's shared
+  // ones).
   bool streams() const { return streams_; }
 
  private:

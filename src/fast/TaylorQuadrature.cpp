@@ -1,8 +1,7 @@
-// TaylorQuadrature's set-up (see the header), compiled once for 2D and 3D: the fit's moment
-// matrices are inverted here (Eigen's dense eigensolver), out of every file that includes the
-// force pass.
-// Eigen's small products inlined in the per-particle part of the force pass (stressAt), as in
-// TlsphForces.cpp.
+// E_q of method/TaylorCorrection.hpp: TaylorQuadrature's set-up (see the header), compiled once for
+// 2D and 3D: the fit's moment matrices are inverted here (Eigen's dense eigensolver), out of every
+// file that includes the force pass. Eigen's small products inlined in the per-particle part of the
+// force pass (stressAt), as in TlsphForces.cpp.
 #ifndef EIGEN_STRONG_INLINE
 #define EIGEN_STRONG_INLINE inline __attribute__((always_inline))
 #endif

@@ -1,4 +1,6 @@
-// Second-order correction of the one-point nodal quadrature of the strain energy (issue 8).
+// E_q and its gradient, as method/TaylorCorrection.hpp, fused into TlsphForces' passes (shared
+// rows, in 3D padded and two particles at a time): the second-order correction of the
+// one-point nodal quadrature of the strain energy.
 //
 // E = sum_I V_I psi(F_I) is the midpoint rule on the particles' lattice cells: for a field
 // whose energy density varies quadratically across a cell it misses
@@ -31,13 +33,13 @@
 #include <span>
 #include <vector>
 
-#include "materials/Material.hpp"
 #include "distributed/Communicator.hpp"
 #include "execution/OrderedSum.hpp"
-#include "fast/Padded.hpp"
 #include "execution/Prefetch.hpp"
-#include "method/ReferenceConfiguration.hpp"
+#include "fast/Padded.hpp"
 #include "fast/SharedRows.hpp"
+#include "materials/Material.hpp"
+#include "method/ReferenceConfiguration.hpp"
 #include "model/Types.hpp"
 
 namespace tlsph {
@@ -91,8 +93,8 @@ class TaylorQuadrature {
   //
   // [grad u | Gs] = sum_J (u_J - u_I) (x) [g_IJ, S_IJ] (6.69 and the fit's second
   // derivatives): row a accumulates du_a [g_IJ, S_IJ], one (D + P)-wide multiply-add per row
-  // and pair, which vectorises across the row (measured 8-11 % faster per step in 3D than the
-  // separate D x D and D x P products, issue 12). 2D; 3D: paddedGradients.
+  // and pair, which vectorises across the row (8-11 % faster per step in 3D than the
+  // separate D x D and D x P products). 2D; 3D: paddedGradients.
   void gradients(Index i, const std::vector<Vec<D>>& u, Mat<D>& gradU, SymMatrix& Gs) const {
     const auto& nb = ref_.neighbours;
     std::array<Fit, D> rows;
@@ -231,7 +233,7 @@ class TaylorQuadrature {
   // In 3D the same sums on padded columns (Padded.hpp): M = [grad u | Gs], column m
   // accumulating (u_J - u_I) times entry m of [g_IJ, S_IJ], one 4-wide multiply-add per column
   // and pair with u gathered as one 256-bit word (the rows above split into 2-wide and scalar
-  // ones, issue 12); F, grad grad u and P^q come out padded for paddedStressAt.
+  // ones); F, grad grad u and P^q come out padded for paddedStressAt.
   using FitSum = PaddedMat<D, D + P>;
   // Written into out from a local (returned by value, the 288-byte result was zeroed with a
   // memset call and copied with a memcpy call per particle).
@@ -257,7 +259,7 @@ class TaylorQuadrature {
   // paddedGradients (the same bits). One particle's sums are nine dependent chains of 4-cycle
   // multiply-adds; held as three 8-wide rows (du_a [g_IJ, S_IJ] without its last entry) and one
   // padded column (du S_IJ's last entry), two particles' eight chains keep both 512-bit FMA
-  // pipes busy (issue 12). Without AVX-512: paddedGradients twice.
+  // pipes busy. Without AVX-512: paddedGradients twice.
   template <bool Ahead = true>
   void paddedGradients(Index i0, Index i1, std::span<const PaddedVec<D>> u, FitSum& out0,
                        FitSum& out1) const {
@@ -301,7 +303,7 @@ class TaylorQuadrature {
   // term; the scalar work is only sigma_a = w C0 : sym(A_a) from the entries of A. Pm is added
   // here, each column in a register, and the sum stored straight into the caller's array:
   // returned by value, GCC wrote P^q in 16-byte halves that the caller reloaded as 256-bit
-  // words (a store-to-load forwarding stall per column, issue 12).
+  // words (a store-to-load forwarding stall per column).
   void paddedStressAt(Index i, const PaddedMat<D>& F, const FitSum& M, const Mat<D>& Pm,
                       PaddedMat<D>& stress) {
     PaddedMat<D> Pq = PaddedMat<D>::Zero();  // P^q: zero where there is no correction
@@ -372,7 +374,7 @@ class TaylorQuadrature {
     [[gnu::always_inline]] void add(const PaddedVec<D>& uj, const double* c) requires(D == 3) {
       // one load of the record's first eight entries, kept in a register: GCC otherwise folds
       // it into each of the three multiply-adds, three 64-byte loads of which, the records
-      // being 72 B apart, most split across two cache lines (+6-10 % per step, Zen 5)
+      // being 72 B apart, most split across two cache lines (+6-10 % per step)
       __m512d first = _mm512_loadu_pd(c);
       __asm__("" : "+v"(first));
       row0 = _mm512_fmadd_pd(_mm512_sub_pd(_mm512_set1_pd(uj[0]), ui0), first, row0);

@@ -1,4 +1,4 @@
-// The per-pair arrays' storage (LargePageAllocator.hpp, issue 12): a block of 2 MiB or more
+// The per-pair arrays' storage (LargePageAllocator.hpp): a block of 2 MiB or more
 // starts on a 2 MiB boundary in a mapping advised for huge pages, smaller blocks keep their
 // type's alignment, and the arrays behave as vectors (growth across the threshold, copies,
 // moves); the reference configuration's per-pair arrays and the per-particle arrays the pair
@@ -13,8 +13,8 @@
 
 #include "TestSupport.hpp"
 #include "execution/LargePageAllocator.hpp"
-#include "method/ReferenceConfiguration.hpp"
 #include "fast/TaylorQuadrature.hpp"
+#include "method/ReferenceConfiguration.hpp"
 
 using namespace tlsph;
 using namespace tlsph::testing;

@@ -1,4 +1,4 @@
-// Prefetching the pair loops' gathers (Prefetch.hpp, issue 12): a hint only, so the forces are
+// Prefetching the pair loops' gathers (Prefetch.hpp): a hint only, so the forces are
 // bit for bit those without it; the rule that turns it on reads the machine's last-level cache.
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-// The explicit step computes with subnormal numbers as zero (SubnormalsToZero.hpp, issue 12):
+// The explicit step computes with subnormal numbers as zero (SubnormalsToZero.hpp):
 // the guard sets and restores the mode on every thread, and a wave's precursor running into
 // a body at rest leaves no subnormal value in the state, where without the guard it does.
 #include <gtest/gtest.h>
@@ -11,8 +11,8 @@
 #endif
 
 #include "TestSupport.hpp"
-#include "explicit/Solver.hpp"
 #include "execution/SubnormalsToZero.hpp"
+#include "explicit/Solver.hpp"
 
 using namespace tlsph;
 using namespace tlsph::testing;

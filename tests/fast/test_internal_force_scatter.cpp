@@ -1,4 +1,4 @@
-// The force pass summed from its sources (InternalForceScatter, issue 12): the same products of
+// The force pass summed from its sources (InternalForceScatter): the same products of
 // the same values in the same order as the gather, so the forces are the gather's bit for bit,
 // with any volumes, ghosts, materials and number of threads; and the pass is used exactly when
 // the internal force is the force pass's only pair term.

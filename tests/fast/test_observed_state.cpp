@@ -1,4 +1,4 @@
-// What observers read after a force pass (TlsphForces::observe, issue 12). In 3D with the energy
+// What observers read after a force pass (TlsphForces::observe). In 3D with the energy
 // penalty on the corrected F the step keeps F only in the penalty's padded copy, and with the
 // Taylor quadrature it does not keep grad grad u; observers get both filled in on their first
 // read after a compute(). What they read must be the last compute()'s state, bit for bit,

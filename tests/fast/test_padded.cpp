@@ -1,4 +1,4 @@
-// The pair loops' padded values (Padded.hpp, issue 12): padding adds a zero fourth row and is
+// The pair loops' padded values (Padded.hpp): padding adds a zero fourth row and is
 // nothing in 2D, transposing keeps the fourth row zero; and the force pass and the energy penalty,
 // which gather padded S_J, R_J, F_J, u_J and X_IJ, give the force of the tangent's own loops, which
 // use the plain D x D values: for the linear-elastic material the force (internal, energy penalty
@@ -10,8 +10,8 @@
 #include <type_traits>
 
 #include "TestSupport.hpp"
-#include "implicit/DofMap.hpp"
 #include "fast/Padded.hpp"
+#include "implicit/DofMap.hpp"
 #include "implicit/TangentStiffness.hpp"
 
 using namespace tlsph;

@@ -1,5 +1,5 @@
-// Pair data for some particles only (buildNeighbourRows, buildReferenceConfiguration's rows;
-// issue 11: a rank keeps the pair data of its own particles and its halo, not the whole
+// Pair data for some particles only (buildNeighbourRows, buildReferenceConfiguration's rows:
+// a distributed rank keeps the pair data of its own particles and its halo, not the whole
 // body's): each built row is bit for bit the whole build's row, the reverse vectors too where
 // the neighbour is built, and the forces on a rank's particles, computed from such a build,
 // are bit for bit the whole build's (2D and 3D, both corrections, Taylor quadrature, both
@@ -9,8 +9,8 @@
 #include <algorithm>
 #include <random>
 
-#include "geometry/Lattice.hpp"
 #include "fast/TlsphForces.hpp"
+#include "geometry/Lattice.hpp"
 
 using namespace tlsph;
 

@@ -1,4 +1,4 @@
-// Per-pair rows stored once per distinct row (SharedRows.hpp, issue 12): every particle reads
+// Per-pair rows stored once per distinct row (SharedRows.hpp): every particle reads
 // back exactly its own row, rows are shared only when equal bit for bit, and the operators that
 // keep their per-pair data this way (the Taylor fit and its reverse) still hold the relations
 // the force's exactness rests on (g_IJ of the fit = the corrected gradient vectors,
@@ -12,9 +12,9 @@
 #include <vector>
 
 #include "TestSupport.hpp"
-#include "method/ReferenceConfiguration.hpp"
 #include "fast/SharedRows.hpp"
 #include "fast/TaylorQuadrature.hpp"
+#include "method/ReferenceConfiguration.hpp"
 
 using namespace tlsph;
 using namespace tlsph::testing;

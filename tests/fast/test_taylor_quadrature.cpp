@@ -1,4 +1,4 @@
-// The second-order quadrature correction of the strain energy (TaylorQuadrature, issue 8):
+// The second-order quadrature correction of the strain energy (TaylorQuadrature):
 // the force is -dE/du of E = sum_I V_I psi(F_I) + E_q (+ E_hg) by central differences, the
 // tangent's product is the central difference of the force, and on a cell-centred lattice the
 // corrected energy of a quadratic displacement field is the exact integral of the linear-elastic
@@ -10,8 +10,8 @@
 
 #include "DifferencedStiffness.hpp"
 #include "TestSupport.hpp"
-#include "implicit/DofMap.hpp"
 #include "explicit/Solver.hpp"
+#include "implicit/DofMap.hpp"
 #include "implicit/TangentStiffness.hpp"
 
 using namespace tlsph;
@@ -79,7 +79,7 @@ TEST(TaylorQuadrature, ForceIsMinusEnergyGradient3D) {
       expectForceIsMinusEnergyGradient<3>(m, alpha, 12);
 }
 
-// The F pass sums two particles at once (issue 12): each particle's [grad u | Gs] must be the
+// The F pass sums two particles at once: each particle's [grad u | Gs] must be the
 // bits of its own sum, whatever its partner and whichever row is longer (a jittered block:
 // rows of different lengths), with the padding row zero.
 TEST(TaylorQuadrature, TwoParticleSumsAreEachParticlesOwn) {
