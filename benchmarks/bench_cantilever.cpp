@@ -14,12 +14,12 @@
 #include <random>
 #include <vector>
 
-#include "geometry/LocalityOrder.hpp"
 #include "execution/LargePageAllocator.hpp"
-#include "geometry/Lattice.hpp"
 #include "execution/Prefetch.hpp"
-#include "explicit/Solver.hpp"
 #include "execution/Threads.hpp"
+#include "explicit/Solver.hpp"
+#include "geometry/Lattice.hpp"
+#include "geometry/LocalityOrder.hpp"
 #ifdef TLSPH_HAVE_MPI
 #include <mpi.h>
 

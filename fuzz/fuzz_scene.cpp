@@ -11,10 +11,10 @@
 #include <string>
 
 #include "materials/ElasticConstants.hpp"
+#include "model/Errors.hpp"
 #include "scene/Config.hpp"
 #include "scene/InputError.hpp"
 #include "scene/SceneBuilder.hpp"
-#include "model/Errors.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size > 8192) return 0;  // scene files are small; long inputs only slow the search

@@ -8,11 +8,11 @@
 #include <string>
 #include <vector>
 
-#include "materials/Material.hpp"
+#include "fast/TlsphForces.hpp"
 #include "geometry/Lattice.hpp"
+#include "materials/Material.hpp"
 #include "method/ReferenceConfiguration.hpp"
 #include "model/Scene.hpp"
-#include "fast/TlsphForces.hpp"
 
 namespace tlsph::testing {
 

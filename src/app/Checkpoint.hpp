@@ -15,10 +15,10 @@
 #include <vector>
 
 #include "app/Guards.hpp"
+#include "explicit/Solver.hpp"
+#include "implicit/NewtonSolver.hpp"
 #include "io/CheckpointArchive.hpp"
 #include "output/PvdFile.hpp"
-#include "implicit/NewtonSolver.hpp"
-#include "explicit/Solver.hpp"
 
 namespace tlsph {
 

@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
+#include "explicit/Solver.hpp"
 #include "output/Frame.hpp"
 #include "scene/SceneSetup.hpp"
-#include "explicit/Solver.hpp"
 
 namespace tlsph {
 

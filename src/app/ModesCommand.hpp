@@ -13,10 +13,10 @@
 #include <string>
 
 #include "app/RunSimulation.hpp"
+#include "implicit/ModalAnalysis.hpp"
 #include "output/CsvSeries.hpp"
 #include "output/VtuSeriesWriter.hpp"
 #include "scene/SceneSetup.hpp"
-#include "implicit/ModalAnalysis.hpp"
 
 namespace tlsph {
 

@@ -16,8 +16,8 @@
 #include <system_error>
 #include <vector>
 
-#include "scene/SceneSetup.hpp"
 #include "explicit/Solver.hpp"
+#include "scene/SceneSetup.hpp"
 
 namespace tlsph {
 

@@ -12,10 +12,10 @@
 #include <utility>
 #include <vector>
 
+#include "geometry/LatticeGrid.hpp"
 #include "geometry/MessageText.hpp"
 #include "geometry/PointSets.hpp"  // select() and boundingBox() go with filling
 #include "geometry/Shape.hpp"
-#include "geometry/LatticeGrid.hpp"
 #include "model/Types.hpp"
 
 namespace tlsph {

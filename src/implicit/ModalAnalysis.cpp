@@ -6,8 +6,8 @@
 #include <cmath>
 #include <sstream>
 
-#include "implicit/ConjugateGradients.hpp"
 #include "explicit/Diagnostics.hpp"
+#include "implicit/ConjugateGradients.hpp"
 #include "implicit/DofMap.hpp"
 #include "implicit/SparseCholesky.hpp"
 #include "implicit/TangentStiffness.hpp"

@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "model/Scene.hpp"
 #include "explicit/Solver.hpp"
+#include "model/Scene.hpp"
 
 namespace tlsph {
 

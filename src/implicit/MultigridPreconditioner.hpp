@@ -19,11 +19,11 @@
 #include <string>
 #include <vector>
 
-#include "implicit/DofMap.hpp"
-#include "model/Scene.hpp"
 #include "explicit/Solver.hpp"
+#include "implicit/DofMap.hpp"
 #include "implicit/SparseCholesky.hpp"
 #include "implicit/TangentStiffness.hpp"
+#include "model/Scene.hpp"
 
 namespace tlsph {
 

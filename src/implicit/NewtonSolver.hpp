@@ -19,12 +19,12 @@
 #include <string>
 #include <vector>
 
-#include "implicit/DofMap.hpp"
-#include "model/Errors.hpp"
-#include "implicit/MultigridPreconditioner.hpp"
 #include "explicit/Solver.hpp"
+#include "implicit/DofMap.hpp"
+#include "implicit/MultigridPreconditioner.hpp"
 #include "implicit/SparseCholesky.hpp"
 #include "implicit/TangentStiffness.hpp"
+#include "model/Errors.hpp"
 
 namespace tlsph {
 

@@ -23,14 +23,14 @@
 #include <variant>
 #include <vector>
 
-#include "materials/Material.hpp"
-#include "implicit/DofMap.hpp"
 #include "fast/EnergyHourglass.hpp"
-#include "model/Errors.hpp"
-#include "method/HourglassStiffness.hpp"
-#include "model/PairTerms.hpp"
-#include "method/ReferenceConfiguration.hpp"
 #include "fast/TaylorQuadrature.hpp"
+#include "implicit/DofMap.hpp"
+#include "materials/Material.hpp"
+#include "method/HourglassStiffness.hpp"
+#include "method/ReferenceConfiguration.hpp"
+#include "model/Errors.hpp"
+#include "model/PairTerms.hpp"
 #include "model/Types.hpp"
 
 namespace tlsph {

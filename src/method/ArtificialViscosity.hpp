@@ -13,8 +13,8 @@
 #include <vector>
 
 #include "materials/Material.hpp"
-#include "model/PairTerms.hpp"
 #include "method/ReferenceConfiguration.hpp"
+#include "model/PairTerms.hpp"
 
 namespace tlsph {
 

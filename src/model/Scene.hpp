@@ -4,12 +4,12 @@
 #include <vector>
 
 #include "materials/Material.hpp"
-#include "model/Conditions.hpp"
 #include "method/Kernel.hpp"
+#include "method/ReferenceConfiguration.hpp"
+#include "model/Conditions.hpp"
 #include "model/PairTerms.hpp"
 #include "model/Particles.hpp"
 #include "model/PeriodicBox.hpp"
-#include "method/ReferenceConfiguration.hpp"
 #include "model/Types.hpp"
 
 namespace tlsph {

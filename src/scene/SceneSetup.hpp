@@ -6,9 +6,9 @@
 #include <string>
 #include <vector>
 
+#include "explicit/Solver.hpp"
 #include "implicit/NewtonSolver.hpp"
 #include "model/Scene.hpp"
-#include "explicit/Solver.hpp"
 
 namespace tlsph {
 

@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
+#include "model/Types.hpp"
 #include "scene/Config.hpp"
 #include "scene/InputError.hpp"
-#include "model/Types.hpp"
 
 namespace tlsph {
 

@@ -8,11 +8,11 @@
 #include <string>
 
 #include "TestSupport.hpp"
+#include "explicit/Diagnostics.hpp"
+#include "explicit/Solver.hpp"
 #include "scene/Config.hpp"
 #include "scene/InputError.hpp"
 #include "scene/SceneBuilder.hpp"
-#include "explicit/Diagnostics.hpp"
-#include "explicit/Solver.hpp"
 
 using namespace tlsph;
 

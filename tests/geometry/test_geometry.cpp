@@ -11,9 +11,9 @@
 #include <string>
 #include <vector>
 
+#include "geometry/Lattice.hpp"
 #include "geometry/LatticeFill.hpp"
 #include "geometry/LocalityOrder.hpp"
-#include "geometry/Lattice.hpp"
 
 using namespace tlsph;
 

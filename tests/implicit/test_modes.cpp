@@ -11,9 +11,9 @@
 
 #include "ProgramRunner.hpp"
 #include "TestSupport.hpp"
+#include "implicit/ModalAnalysis.hpp"
 #include "scene/Config.hpp"
 #include "scene/SceneBuilder.hpp"
-#include "implicit/ModalAnalysis.hpp"
 
 using namespace tlsph;
 using namespace tlsph::testing;

@@ -14,13 +14,13 @@
 #include <string>
 
 #include "app/RunSimulation.hpp"
+#include "geometry/Lattice.hpp"
+#include "implicit/ConjugateGradients.hpp"
+#include "implicit/MlsInterpolation.hpp"
+#include "implicit/MultigridPreconditioner.hpp"
 #include "scene/Config.hpp"
 #include "scene/InputError.hpp"
 #include "scene/SceneBuilder.hpp"
-#include "implicit/ConjugateGradients.hpp"
-#include "geometry/Lattice.hpp"
-#include "implicit/MlsInterpolation.hpp"
-#include "implicit/MultigridPreconditioner.hpp"
 
 using namespace tlsph;
 namespace fs = std::filesystem;

@@ -9,10 +9,10 @@
 
 #include "DifferencedStiffness.hpp"
 #include "TestSupport.hpp"
-#include "scene/SceneBuilder.hpp"
-#include "implicit/DofMap.hpp"
 #include "explicit/Solver.hpp"
+#include "implicit/DofMap.hpp"
 #include "implicit/TangentStiffness.hpp"
+#include "scene/SceneBuilder.hpp"
 
 using namespace tlsph;
 using namespace tlsph::testing;

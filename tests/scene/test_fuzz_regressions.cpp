@@ -7,10 +7,10 @@
 #include <sstream>
 
 #include "materials/ElasticConstants.hpp"
+#include "model/Errors.hpp"
 #include "scene/Config.hpp"
 #include "scene/InputError.hpp"
 #include "scene/SceneBuilder.hpp"
-#include "model/Errors.hpp"
 
 namespace fs = std::filesystem;
 using namespace tlsph;
