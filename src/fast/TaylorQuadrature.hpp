@@ -153,8 +153,9 @@ class TaylorQuadrature {
     return R_[j] * *T;
   }
 
-  // Linearised: dstress[i] += dP^q_i and the linearised hyperstress force, for the direction v
-  // (with dH its displacement gradient) about the state (F, G) of a force pass.
+  // Linearised (method/TaylorCorrection::linearised): dstress[i] += dP^q_i and the linearised
+  // hyperstress force, for the direction v (with dH its displacement gradient) about the state
+  // (F, G) of a force pass.
   void linearise(const std::vector<Vec<D>>& v, const std::vector<Mat<D>>& dH,
                  std::span<const Mat<D>> F, const std::vector<SymMatrix>& Gs,
                  std::vector<Mat<D>>& dstress) {

@@ -11,6 +11,7 @@
 #include "implicit/DofMap.hpp"
 #include "implicit/SparseCholesky.hpp"
 #include "implicit/TangentStiffness.hpp"
+#include "method/DeformationGradient.hpp"
 
 namespace tlsph {
 
@@ -59,10 +60,9 @@ template <int D>
 double hourglassContentOf(const ReferenceConfiguration<D>& ref, const std::vector<double>& volume,
                           const std::vector<Vec<D>>& u) {
   const auto& nb = ref.neighbours;
-  std::vector<Mat<D>> H(ref.particleCount(), Mat<D>::Zero());
+  std::vector<Mat<D>> H(ref.particleCount());
   for (Index i = 0; i < ref.particleCount(); ++i)
-    for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k)
-      H[i] += (u[nb.neighbour[k]] - u[i]) * ref.correctedGradient[k].transpose();
+    H[i] = displacementGradientAt<D>(nb, ref.correctedGradient, u, i);
   return hourglassContent(ref, volume, u, H);
 }
 

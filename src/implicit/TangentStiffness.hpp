@@ -13,6 +13,10 @@
 //               within I's own stencil: the same sparsity as the strain part (neighbours of
 //               neighbours) instead of three kernel radii. Exact when the penalty is off; with
 //               it, the preconditioner of the exact operator (NewtonSolver).
+// The product is in every conjugate-gradient iteration, so its penalty and Taylor parts run on
+// the fast passes (fast/EnergyHourglass on the direction; fast/TaylorQuadrature::linearise,
+// method/TaylorCorrection::linearised fused); the tests hold K v to central differences of the
+// plain force of method/PairForces.
 #pragma once
 
 #include <Eigen/Sparse>

@@ -26,6 +26,17 @@ Mat<D> deformationGradientAt(const NeighbourList& nb, const PairArray<Vec<D>>& g
 }
 
 // F of every particle for the gradient vectors g.
+// H_I = F_I - 1 = sum_J (u_J - u_I) (x) g_IJ, summed without the 1: (6.69) for a direction
+// (a mode shape, a tangent's dH), where 1 + dH would round dH off.
+template <int D>
+Mat<D> displacementGradientAt(const NeighbourList& nb, const PairArray<Vec<D>>& g,
+                              const std::vector<Vec<D>>& u, Index i) {
+  Mat<D> H = Mat<D>::Zero();
+  for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k)
+    H += (u[nb.neighbour[k]] - u[i]) * g[k].transpose();
+  return H;
+}
+
 template <int D>
 std::vector<Mat<D>> deformationGradients(const ReferenceConfiguration<D>& ref,
                                          const PairArray<Vec<D>>& g, const std::vector<Vec<D>>& u) {

@@ -98,6 +98,34 @@ class TaylorCorrection {
     return R;
   }
 
+  // The linearisation of stress() and hyperstress() about (F, G) in a direction whose
+  // displacement gradient is dH and second gradients dG (the tangent stiffness's part of the
+  // term): with sigma_a = c_I C0 : e_a and de_a = sym(dH^T G_a + F^T dG_a) (sym(dG_a) for
+  // the linear-elastic material),
+  //   dP^q = sum_a (dG_a sigma_a + G_a dsigma_a),   dR_a = dH sigma_a + F dsigma_a.
+  struct Linearised {
+    Mat<D> stress;
+    Gradients hyperstress;
+  };
+  Linearised linearised(Index i, const Mat<D>& F, const Gradients& G, const Mat<D>& dH,
+                        const Gradients& dG) const {
+    Linearised d;
+    d.stress.setZero();
+    for (int a = 0; a < D; ++a) {
+      const Mat<D> sigma = weight_[i] * smallStrainStress(i, strain(i, F, G[a]));
+      const Mat<D> A =
+          smallStrain_[i] ? dG[a] : Mat<D>(dH.transpose() * G[a] + F.transpose() * dG[a]);
+      const Mat<D> dsigma = weight_[i] * smallStrainStress(i, 0.5 * (A + A.transpose()));
+      if (smallStrain_[i]) {
+        d.hyperstress[a] = dsigma;
+      } else {
+        d.stress += dG[a] * sigma + G[a] * dsigma;
+        d.hyperstress[a] = dH * sigma + F * dsigma;
+      }
+    }
+    return d;
+  }
+
   // f -= the part of dE_q/du through G: each pair sends V_I sum_a R_Ia S_IJ(:, a) to J and
   // takes it from I (the pair sum of InternalForce.hpp, one order up).
   void addHyperstressForce(const std::vector<Mat<D>>& F, const std::vector<Gradients>& G,

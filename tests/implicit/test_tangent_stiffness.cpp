@@ -12,6 +12,7 @@
 #include "explicit/Solver.hpp"
 #include "implicit/DofMap.hpp"
 #include "implicit/TangentStiffness.hpp"
+#include "method/PairForces.hpp"
 #include "scene/SceneBuilder.hpp"
 
 using namespace tlsph;
@@ -197,6 +198,67 @@ TEST(TangentStiffness, ChainsMirroredGhostsAndEliminatesPrescribedParticles) {
     expectTangent<3>({"saint-venant-kirchhoff", GradientCorrection::Quadratic, alpha}, true,
                      seed++);
   }
+}
+
+// The tangent's products run on the fast passes (the run's force pass for F and grad grad u,
+// the fused penalty and the linearised Taylor term); here K v is held to the central difference
+// of the plain force of method/PairForces, with the Taylor quadrature and the energy penalty on
+// either F, along random directions v.
+template <int D>
+void expectTangentOfThePlainForce(const Case& c, std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  Scene<D> scene = heldBlock<D>(c, false, rng);
+  scene.quadrature = Quadrature::Taylor;
+  auto& p = scene.particles;
+  Solver<D> solver(scene);
+  const Mat<D> A = randomMatrix<D>(rng, 0.08);
+  for (Index i = 0; i < p.size(); ++i)
+    if (p.motion[i] == Motion::Free)
+      p.displacement[i] = A * p.referencePosition[i] + randomVector<D>(rng, 0.04 * kDx);
+  solver.reevaluate();
+  DofMap<D> dofs(p, scene.mirrorGhosts);
+  TangentStiffness<D> K(solver.reference(), scene.materials, p.material, p.volume,
+                        scene.hourglass(), dofs, scene.quadrature);
+  K.update(solver.forces().deformationGradient());
+  K.updateQuadrature(solver.forces().quadrature(), solver.forces().deformationGradient());
+  PairForces<D> plain(solver.reference(), scene.materials, p.material, p.volume, scene.hourglass(),
+                      scene.quadrature);
+  const auto& free = dofs.freeParticles();
+  auto netForce = [&](double s, const Eigen::VectorXd& v) {
+    std::vector<Vec<D>> u = p.displacement, f;
+    for (std::size_t d = 0; d < free.size(); ++d)
+      u[free[d]] += s * v.template segment<D>(D * d);
+    plain.compute(u, f);
+    Eigen::VectorXd out(D * free.size());
+    for (std::size_t d = 0; d < free.size(); ++d)
+      out.template segment<D>(D * d) = f[free[d]];
+    return out;
+  };
+  SCOPED_TRACE(c.material + " " + gradientCorrectionName(c.correction) + " alpha " +
+               std::to_string(c.alpha) + " D=" + std::to_string(D));
+  for (int trial = 0; trial < 3; ++trial) {
+    Eigen::VectorXd v(K.size()), Kv;
+    for (Eigen::Index k = 0; k < v.size(); ++k)
+      v[k] = std::uniform_real_distribution<double>(-1.0, 1.0)(rng);
+    K.apply(v, Kv);
+    const double h = 1e-6 * kDx;
+    const Eigen::VectorXd fd = -(netForce(h, v) - netForce(-h, v)) / (2.0 * h);
+    EXPECT_LT((Kv - fd).norm(), 1e-6 * fd.norm());
+  }
+}
+
+TEST(TangentStiffness, MatchesFiniteDifferencesOfThePlainForce) {
+  std::uint32_t seed = 51;
+  for (const std::string material : {"linear-elastic", "neo-hookean"})
+    for (double alpha : {0.0, 10.0}) {
+      expectTangentOfThePlainForce<2>({material, GradientCorrection::Quadratic, alpha}, seed++);
+      expectTangentOfThePlainForce<3>({material, GradientCorrection::Quadratic, alpha}, seed++);
+    }
+  expectTangentOfThePlainForce<2>(
+      {"mooney-rivlin", GradientCorrection::Quadratic, 10.0, HourglassGradient::Linear}, seed++);
+  expectTangentOfThePlainForce<3>(
+      {"saint-venant-kirchhoff", GradientCorrection::Quadratic, 10.0, HourglassGradient::Linear},
+      seed++);
 }
 
 TEST(TangentStiffness, RejectsTheTextbookHourglassForm) {

@@ -40,6 +40,11 @@ void expectAffineExactness(KernelType kernel, double supportRatio, std::uint32_t
       ASSERT_LT((F[i] - A).norm(), 1e-12 * A.norm())
           << "particle " << i << " with " << eval.reference().neighbours.count(i) << " neighbours";
       ASSERT_LT((Flinear[i] - A).norm(), 1e-12 * A.norm()) << "linear F, particle " << i;
+      // H = F - 1 summed without the 1: exact to the rounding of H itself
+      const Mat<D> H = displacementGradientAt<D>(eval.reference().neighbours,
+                                                 eval.reference().correctedGradient, u, i);
+      const Mat<D> exactH = A - Mat<D>::Identity();
+      ASSERT_LT((H - exactH).norm(), 1e-12 * exactH.norm()) << "H, particle " << i;
     }
   }
 }

@@ -193,6 +193,58 @@ void expectExactForQuadraticFields(std::uint32_t seed) {
   EXPECT_GT(std::abs(En - exact), 1e-3 * exact);  // the nodal sum alone is not exact
 }
 
+// linearised() is the directional derivative of stress() and hyperstress(): central
+// differences of both along a random direction v about a bent state, at every particle.
+template <int D>
+void expectLinearisation(const std::string& material, std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  PlainEvaluator<D> eval(blockScene<D>(material, 0.0, 0.15, rng));
+  const TaylorCorrection<D>& q = *eval.forces().quadrature();
+  const auto& ref = eval.reference();
+  const auto u = bentField<D>(eval.X(), rng, 0.03);
+  std::vector<Vec<D>> v(u.size());
+  for (auto& vi : v)
+    vi = randomVector<D>(rng, kDx);
+  using Gradients = typename TaylorCorrection<D>::Gradients;
+  auto along = [&](double s) {
+    std::vector<Vec<D>> w(u.size());
+    for (std::size_t j = 0; j < u.size(); ++j)
+      w[j] = u[j] + s * v[j];
+    return w;
+  };
+  const double h = 1e-6;
+  const auto w0 = along(0.0), wp = along(h), wm = along(-h);
+  double worstP = 0.0, worstR = 0.0, scaleP = 0.0, scaleR = 0.0;
+  for (Index i = 0; i < eval.size(); ++i) {
+    auto F = [&](const std::vector<Vec<D>>& w) {
+      return deformationGradientAt<D>(ref.neighbours, ref.correctedGradient, w, i);
+    };
+    const Gradients G = q.secondGradients(i, w0), Gp = q.secondGradients(i, wp),
+                    Gm = q.secondGradients(i, wm);
+    const Mat<D> dH = displacementGradientAt<D>(ref.neighbours, ref.correctedGradient, v, i);
+    const auto d = q.linearised(i, F(w0), G, dH, q.secondGradients(i, v));
+    const Mat<D> dP = (q.stress(i, F(wp), Gp) - q.stress(i, F(wm), Gm)) / (2.0 * h);
+    worstP = std::max(worstP, (d.stress - dP).cwiseAbs().maxCoeff());
+    scaleP = std::max(scaleP, dP.cwiseAbs().maxCoeff());
+    const Gradients Rp = q.hyperstress(i, F(wp), Gp), Rm = q.hyperstress(i, F(wm), Gm);
+    for (int a = 0; a < D; ++a) {
+      const Mat<D> dR = (Rp[a] - Rm[a]) / (2.0 * h);
+      worstR = std::max(worstR, (d.hyperstress[a] - dR).cwiseAbs().maxCoeff());
+      scaleR = std::max(scaleR, dR.cwiseAbs().maxCoeff());
+    }
+  }
+  SCOPED_TRACE(material + " D=" + std::to_string(D));
+  EXPECT_GT(scaleR, 0.0);
+  EXPECT_LT(worstR, 1e-7 * scaleR);
+  const bool small = material == "linear-elastic";  // e_a = sym(G_a): no P^q
+  if (small) {
+    EXPECT_EQ(scaleP, 0.0);
+  } else {
+    EXPECT_GT(scaleP, 0.0);
+    EXPECT_LT(worstP, 1e-7 * scaleP);
+  }
+}
+
 const char* const kMaterials[] = {"linear-elastic", "saint-venant-kirchhoff", "neo-hookean",
                                   "mooney-rivlin"};
 
@@ -223,4 +275,10 @@ TEST(TaylorCorrection, ConservesMomentum) {
 TEST(TaylorCorrection, ExactForQuadraticFieldsOnALattice) {
   expectExactForQuadraticFields<2>(31);
   expectExactForQuadraticFields<3>(32);
+}
+TEST(TaylorCorrection, LinearisationIsTheDirectionalDerivative) {
+  for (const char* m : kMaterials) {
+    expectLinearisation<2>(m, 41);
+    expectLinearisation<3>(m, 42);
+  }
 }
