@@ -13,7 +13,7 @@
 #include <string>
 
 #include "app/RunSimulation.hpp"
-#include "implicit/ModalAnalysis.hpp"
+#include "modes/ModalAnalysis.hpp"
 #include "output/CsvSeries.hpp"
 #include "output/VtuSeriesWriter.hpp"
 #include "scene/SceneSetup.hpp"

@@ -11,7 +11,7 @@
 
 #include "ProgramRunner.hpp"
 #include "TestSupport.hpp"
-#include "implicit/ModalAnalysis.hpp"
+#include "modes/ModalAnalysis.hpp"
 #include "scene/Config.hpp"
 #include "scene/SceneBuilder.hpp"
 

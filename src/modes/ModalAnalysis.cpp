@@ -1,4 +1,4 @@
-#include "implicit/ModalAnalysis.hpp"
+#include "modes/ModalAnalysis.hpp"
 
 #include <Spectra/SymEigsShiftSolver.h>
 
