@@ -3,7 +3,11 @@
 #include <Spectra/SymEigsShiftSolver.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <numeric>
+#include <optional>
+#include <random>
 #include <sstream>
 
 #include "explicit/Diagnostics.hpp"
@@ -11,6 +15,8 @@
 #include "implicit/DofMap.hpp"
 #include "implicit/SparseCholesky.hpp"
 #include "implicit/TangentStiffness.hpp"
+#include "modes/ExactStiffness.hpp"
+#include "modes/Inertia.hpp"
 
 namespace tlsph {
 
@@ -26,8 +32,14 @@ class ShiftInvert {
   Eigen::Index rows() const { return mass_.size(); }
   Eigen::Index cols() const { return mass_.size(); }
   void set_shift(double sigma) { sigma_ = sigma; }
+  // Orthonormal directions (in the space of M^{1/2} phi) the operator is to leave out: the
+  // modes found by earlier runs. P A P with P = 1 - Q Q^T maps them to 0, far from the
+  // eigenvalues 1 / (lambda - sigma) sought, and leaves the others as they are.
+  void deflate(const Eigen::MatrixXd* Q) { deflated_ = Q; }
   void perform_op(const double* in, double* out) const {
-    const Eigen::VectorXd b = root_.cwiseProduct(Eigen::Map<const Eigen::VectorXd>(in, rows()));
+    Eigen::VectorXd x = Eigen::Map<const Eigen::VectorXd>(in, rows());
+    project(x);
+    const Eigen::VectorXd b = root_.cwiseProduct(x);
     Eigen::VectorXd y = factor_.solve(b);
     const auto cg = conjugateGradients(
         [&](const Eigen::VectorXd& v, Eigen::VectorXd& Kv) {
@@ -38,7 +50,12 @@ class ShiftInvert {
     if (cg.negativeCurvature) notPositive_ = true;
     iterations_ += cg.iterations;
     ++solves_;
-    Eigen::Map<Eigen::VectorXd>(out, rows()) = root_.cwiseProduct(y);
+    Eigen::VectorXd result = root_.cwiseProduct(y);
+    project(result);
+    Eigen::Map<Eigen::VectorXd>(out, rows()) = result;
+  }
+  void project(Eigen::VectorXd& x) const {
+    if (deflated_ && deflated_->cols() > 0) x -= *deflated_ * (deflated_->transpose() * x);
   }
   long iterations() const { return iterations_; }
   long solves() const { return solves_; }
@@ -50,6 +67,7 @@ class ShiftInvert {
   const Eigen::VectorXd& mass_;
   Eigen::VectorXd root_;
   double sigma_ = 0.0;
+  const Eigen::MatrixXd* deflated_ = nullptr;
   mutable long iterations_ = 0, solves_ = 0;
   mutable bool notPositive_ = false;
 };
@@ -64,6 +82,39 @@ double hourglassContentOf(const ReferenceConfiguration<D>& ref, const std::vecto
     for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k)
       H[i] += (u[nb.neighbour[k]] - u[i]) * ref.correctedGradient[k].transpose();
   return hourglassContent(ref, volume, u, H);
+}
+
+// One Lanczos run for the `nev` lowest eigenpairs of the operator deflated of `Q`; returns the
+// converged ones (eigenvalues, and the eigenvectors in the M^{1/2} phi space as columns).
+template <int D>
+std::pair<Eigen::VectorXd, Eigen::MatrixXd> lanczos(ShiftInvert<D>& op, const Eigen::MatrixXd& Q,
+                                                    Eigen::Index nev, double shift, int round) {
+  const Eigen::Index n = op.rows();
+  const Eigen::Index free = n - Q.cols();
+  nev = std::min(nev, free - 1);
+  if (nev < 1) return {};
+  const Eigen::Index ncv = std::min(free, std::max<Eigen::Index>(2 * nev + 1, 20));
+  op.deflate(&Q);
+  Spectra::SymEigsShiftSolver<ShiftInvert<D>> eigs(op, nev, ncv, shift);
+  // another start vector each run: the first run's would again see the missed direction weakly
+  std::mt19937_64 random(1234567 + round);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  Eigen::VectorXd start(n);
+  for (Eigen::Index i = 0; i < n; ++i)
+    start[i] = uniform(random);
+  op.project(start);
+  eigs.init(start.data());
+  eigs.compute(Spectra::SortRule::LargestMagn, 1000, 1e-10, Spectra::SortRule::SmallestAlge);
+  op.deflate(nullptr);
+  return {eigs.eigenvalues(), eigs.eigenvectors()};
+}
+
+// The cut in omega^2 of a band edge at f Hz: eigenvalues below it are below f. 0 Hz takes the
+// zero modes in (the cut below them), a positive edge below sigma_0 leaves them out.
+double bandCut(double hz, double zeroShift) {
+  const double pi = std::acos(-1.0);
+  if (hz == 0.0) return -zeroShift;
+  return std::max(std::pow(2.0 * pi * hz, 2), zeroShift);
 }
 
 }  // namespace
@@ -105,11 +156,73 @@ ModalResult<D> computeModes(const Scene<D>& scene, Solver<D>& solver,
 
   ModalResult<D> result;
   result.expectedRigidModes = expectedRigidBodyModes(scene);
+
+  // The exact K and its inertia, before the assembled matrix is shifted below.
+  InertiaCheck& check = result.inertia;
+  std::optional<Inertia> inertia;
+  {
+    const auto start = std::chrono::steady_clock::now();
+    const ExactStiffness exact = exactStiffness(K, solver.reference(), dofs,
+                                                scene.hourglass().enabled(), settings.maxNonZeros);
+    check.exactK = exact.method;
+    check.probes = exact.products;
+    check.groups = exact.groups;
+    check.kNonZeros = exact.nonZeros;
+    check.mismatch = exact.productMismatch;
+    check.kSeconds = exact.seconds;
+    if (exact.made) {
+      inertia.emplace(exact.lower, mass);
+      check.factorNonZeros = inertia->factorNonZeros();
+      if (check.factorNonZeros > settings.maxNonZeros) {
+        std::ostringstream why;
+        why << "its L D L^T factor would hold " << check.factorNonZeros
+            << " entries, above the limit of " << settings.maxNonZeros;
+        check.why = why.str();
+        inertia.reset();
+      }
+    } else {
+      check.why = exact.reason;
+    }
+    check.made = inertia.has_value();
+    check.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+  auto countBelow = [&](double sigma) {
+    const auto start = std::chrono::steady_clock::now();
+    long below = inertia->countBelow(sigma);
+    // an exactly zero pivot: sigma on an eigenvalue; a shift off it by far less than the gaps
+    // the callers keep counts the same
+    for (int tries = 0; below < 0 && tries < 4; ++tries)
+      below = inertia->countBelow(sigma + 1e-9 * (std::abs(sigma) + result.zeroShift));
+    if (below < 0) throw SetupError("the L D L^T factorisation of K - sigma M broke down");
+    check.factorisations = inertia->factorisations();
+    check.seconds +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return below;
+  };
+
   const auto& assembled = K.assemble();
   // The diagonal of the assembled matrix: the first entry of each column (lower triangle).
   for (Eigen::Index c = 0; c < n; ++c) {
     const double diagonal = assembled.valuePtr()[assembled.outerIndexPtr()[c]];
     result.eigenvalueScale = std::max(result.eigenvalueScale, diagonal / mass[c]);
+  }
+  result.zeroShift = settings.zeroShift * result.eigenvalueScale;
+  if (inertia) {
+    result.zeroModes = static_cast<int>(countBelow(result.zeroShift));
+    result.zeroModesByInertia = true;
+  }
+  long wanted = settings.count;
+  if (settings.band) {
+    result.bandLow = bandCut(settings.lowHz, result.zeroShift);
+    result.bandHigh = bandCut(settings.highHz, result.zeroShift);
+    if (settings.highHz == 0.0) result.bandHigh = result.zeroShift;
+    if (inertia) {
+      const long high = countBelow(result.bandHigh);
+      result.inBand = high - countBelow(result.bandLow);
+      wanted = high;
+    } else {
+      wanted = 12;  // then doubled until a mode above the band is found
+    }
   }
   // Just below zero: K - sigma M is positive definite even with rigid-body modes, and the
   // eigenvalues nearest sigma are the lowest.
@@ -123,31 +236,100 @@ ModalResult<D> computeModes(const Scene<D>& scene, Solver<D>& solver,
   result.factorNonZeros = factor.factorNonZeros();
   result.linearSolver = SparseCholesky::name();
 
+  // Lanczos runs until the modes found below the cut are all there are (by inertia).
   ShiftInvert<D> op(K, factor, mass);
-  const Eigen::Index nev = std::min<Eigen::Index>(settings.count, n - 1);
-  const Eigen::Index ncv = std::min<Eigen::Index>(n, std::max<Eigen::Index>(2 * nev + 1, 20));
-  Spectra::SymEigsShiftSolver<ShiftInvert<D>> eigs(op, nev, ncv, result.shift);
-  eigs.init();
-  eigs.compute(Spectra::SortRule::LargestMagn, 1000, 1e-10, Spectra::SortRule::SmallestAlge);
+  Eigen::VectorXd lambda(0);
+  Eigen::MatrixXd psi(n, 0);
+  Eigen::Index nev = std::min<Eigen::Index>(std::max<long>(wanted, 1), n - 1);
+  for (int round = 0; round < settings.maxRounds && nev > 0; ++round) {
+    const auto [values, vectors] = lanczos(op, psi, nev, result.shift, round);
+    ++result.rounds;
+    if (op.notPositive())
+      throw SetupError(
+          "the stiffness is not positive definite about this state (buckled or "
+          "inverted material): its modes are not vibrations");
+    if (values.size() == 0 && round == 0) {
+      std::ostringstream msg;
+      msg << "the eigensolver did not converge for the lowest " << nev << " modes";
+      throw SetupError(msg.str());
+    }
+    // merged by increasing eigenvalue; the new vectors made orthogonal to the old ones (they
+    // are, to the accuracy of the run)
+    Eigen::VectorXd allValues(lambda.size() + values.size());
+    Eigen::MatrixXd allVectors(n, lambda.size() + values.size());
+    allValues << lambda, values;
+    allVectors << psi, vectors;
+    for (Eigen::Index c = psi.cols(); c < allVectors.cols(); ++c) {
+      for (Eigen::Index k = 0; k < c; ++k)
+        allVectors.col(c) -= allVectors.col(k).dot(allVectors.col(c)) * allVectors.col(k);
+      allVectors.col(c).normalize();
+    }
+    std::vector<Eigen::Index> order(allValues.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::sort(order.begin(), order.end(),
+              [&](Eigen::Index a, Eigen::Index b) { return allValues[a] < allValues[b]; });
+    lambda.resize(allValues.size());
+    psi.resize(n, allValues.size());
+    for (std::size_t k = 0; k < order.size(); ++k) {
+      lambda[k] = allValues[order[k]];
+      psi.col(k) = allVectors.col(order[k]);
+    }
+    nev = 0;
+    if (!inertia) {
+      // no count to check against: one run, or with a band until a mode above it is found
+      if (settings.band && lambda.size() > 0 && lambda[lambda.size() - 1] < result.bandHigh &&
+          lambda.size() < n - 1)
+        nev = std::min<Eigen::Index>(lambda.size(), n - 1 - lambda.size());
+      continue;
+    }
+    // The cut: the band's upper edge, or just above the highest mode to be listed (sigma_0
+    // when that is a zero mode, so that the whole null space is found), with a relative gap
+    // well above the modes' accuracy (1e-10) and the factorisation's rounding.
+    if (settings.band) {
+      check.cut = result.bandHigh;
+    } else {
+      const Eigen::Index top = std::min<Eigen::Index>(wanted, lambda.size()) - 1;
+      check.cut = lambda[top] < result.zeroShift ? result.zeroShift
+                                                 : lambda[top] + 1e-4 * std::abs(lambda[top]);
+    }
+    check.below = countBelow(check.cut);
+    check.found = (lambda.array() < check.cut).count();
+    check.complete = check.below == check.found && lambda.size() >= std::min<long>(wanted, n - 1);
+    if (check.complete || check.below < check.found) break;
+    // the missing ones are the lowest the deflated operator has: ask for them and a few more
+    nev = std::min<Eigen::Index>(check.below - check.found + 2, n - 1 - lambda.size());
+    if (lambda.size() < wanted) nev = std::max<Eigen::Index>(nev, wanted - lambda.size());
+  }
   result.krylovIterations = op.iterations();
   result.solves = op.solves();
-  if (op.notPositive())
-    throw SetupError(
-        "the stiffness is not positive definite about this state (buckled or "
-        "inverted material): its modes are not vibrations");
-  if (eigs.info() != Spectra::CompInfo::Successful) {
+  if (inertia && !check.complete) {
     std::ostringstream msg;
-    msg << "the eigensolver did not converge for the lowest " << nev << " modes";
-    throw SetupError(msg.str());
+    msg << "the modes found are not all the eigenvalues below omega^2 = " << check.cut
+        << ": the inertia of K - s M counts " << check.below << " below it, " << result.rounds
+        << " Lanczos run(s) found " << check.found
+        << "; the list would not be the lowest modes, so none is given";
+    throw IncompleteModes(msg.str());
   }
-  const Eigen::VectorXd lambda = eigs.eigenvalues();
-  const Eigen::MatrixXd psi = eigs.eigenvectors();
+
+  // The modes listed: the lowest `count`, or those in the band.
+  std::vector<Eigen::Index> listed;
+  for (Eigen::Index m = 0; m < lambda.size(); ++m)
+    if (settings.band ? lambda[m] >= result.bandLow && lambda[m] < result.bandHigh
+                      : m < settings.count)
+      listed.push_back(m);
+  if (!inertia) {
+    result.zeroModes = 0;
+    for (Eigen::Index m = 0; m < lambda.size(); ++m)
+      result.zeroModes += lambda[m] < result.zeroShift;
+  }
   const double pi = std::acos(-1.0);
   std::vector<Vec<D>> full(p.size());
-  for (Eigen::Index m = 0; m < lambda.size(); ++m) {
+  for (Eigen::Index m : listed) {
     Mode<D> mode;
     mode.eigenvalue = lambda[m];
-    mode.zero = std::abs(lambda[m]) < settings.zeroThreshold * result.eigenvalueScale;
+    // by the count: the zero modes are the lowest (when the list is complete, exactly those
+    // below sigma_0)
+    mode.zero = inertia ? m < result.zeroModes : lambda[m] < result.zeroShift;
     mode.frequency = mode.zero ? 0.0 : std::sqrt(std::max(lambda[m], 0.0)) / (2.0 * pi);
     const Eigen::VectorXd phi = psi.col(m).cwiseQuotient(mass.cwiseSqrt());
     Eigen::VectorXd Kphi, Khg;
@@ -164,7 +346,6 @@ ModalResult<D> computeModes(const Scene<D>& scene, Solver<D>& solver,
     if (largest > 0.0)
       for (auto& u : mode.shape)
         u /= largest;
-    result.zeroModes += mode.zero;
     result.modes.push_back(std::move(mode));
   }
   return result;
