@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <map>
 #include <numeric>
 #include <optional>
 #include <random>
@@ -186,7 +187,9 @@ ModalResult<D> computeModes(const Scene<D>& scene, Solver<D>& solver,
     check.made = inertia.has_value();
     check.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
+  std::map<double, long> counted;  // a shift asked for again is not factorised again
   auto countBelow = [&](double sigma) {
+    if (const auto known = counted.find(sigma); known != counted.end()) return known->second;
     const auto start = std::chrono::steady_clock::now();
     long below = inertia->countBelow(sigma);
     // an exactly zero pivot: sigma on an eigenvalue; a shift off it by far less than the gaps
@@ -197,6 +200,7 @@ ModalResult<D> computeModes(const Scene<D>& scene, Solver<D>& solver,
     check.factorisations = inertia->factorisations();
     check.seconds +=
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    counted[sigma] = below;
     return below;
   };
 
@@ -207,19 +211,13 @@ ModalResult<D> computeModes(const Scene<D>& scene, Solver<D>& solver,
     result.eigenvalueScale = std::max(result.eigenvalueScale, diagonal / mass[c]);
   }
   result.zeroShift = settings.zeroShift * result.eigenvalueScale;
-  if (inertia) {
-    result.zeroModes = static_cast<int>(countBelow(result.zeroShift));
-    result.zeroModesByInertia = true;
-  }
   long wanted = settings.count;
   if (settings.band) {
     result.bandLow = bandCut(settings.lowHz, result.zeroShift);
     result.bandHigh = bandCut(settings.highHz, result.zeroShift);
     if (settings.highHz == 0.0) result.bandHigh = result.zeroShift;
     if (inertia) {
-      const long high = countBelow(result.bandHigh);
-      result.inBand = high - countBelow(result.bandLow);
-      wanted = high;
+      wanted = countBelow(result.bandHigh);
     } else {
       wanted = 12;  // then doubled until a mode above the band is found
     }
@@ -311,6 +309,14 @@ ModalResult<D> computeModes(const Scene<D>& scene, Solver<D>& solver,
     throw IncompleteModes(msg.str());
   }
 
+  // Once the modes found below the cut are all the eigenvalues below it (by inertia), the counts
+  // below any lower shift are those of the modes found: the zero modes below sigma_0 <= cut and
+  // the band's lower edge need no factorisation of their own.
+  if (inertia) {
+    result.zeroModes = static_cast<int>((lambda.array() < result.zeroShift).count());
+    result.zeroModesByInertia = true;
+    if (settings.band) result.inBand = wanted - (lambda.array() < result.bandLow).count();
+  }
   // The modes listed: the lowest `count`, or those in the band.
   std::vector<Eigen::Index> listed;
   for (Eigen::Index m = 0; m < lambda.size(); ++m)
@@ -318,7 +324,6 @@ ModalResult<D> computeModes(const Scene<D>& scene, Solver<D>& solver,
                       : m < settings.count)
       listed.push_back(m);
   if (!inertia) {
-    result.zeroModes = 0;
     for (Eigen::Index m = 0; m < lambda.size(); ++m)
       result.zeroModes += lambda[m] < result.zeroShift;
   }

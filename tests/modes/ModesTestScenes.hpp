@@ -27,7 +27,7 @@ inline const char* shapeName(Shape s) {
   return s == Shape::Box ? "box" : s == Shape::Cylinder ? "cylinder" : "polygon";
 }
 
-// A free body (no condition) of about 60 (2D) / 100-150 (3D) particles at dx = 0.01, or with
+// A free body (no condition) of about 60 (2D) / 60-80 (3D) particles at dx = 0.01, or with
 // `hold` its face x = 0 clamped by mirrored ghosts ("clamp") or by prescribed particles
 // ("prescribe").
 template <int D>
@@ -44,12 +44,12 @@ std::string bodyText(Shape shape, const Numerics& n, const std::string& hold = "
     if (shape == Shape::Polygon)
       s << "shape = polygon\nvertices = 0 0, 0.1 0, 0.1 0.04, 0.05 0.04, 0.03 0.08, 0 0.07\n";
   } else {
-    if (shape == Shape::Box) s << "shape = box\nlower = 0 0 0\nupper = 0.06 0.04 0.04\n";
+    if (shape == Shape::Box) s << "shape = box\nlower = 0 0 0\nupper = 0.05 0.04 0.04\n";
     if (shape == Shape::Cylinder)
-      s << "shape = cylinder\nstart = 0 0.025 0.025\nend = 0.06 0.025 0.025\nradius = 0.025\n";
+      s << "shape = cylinder\nstart = 0 0.02 0.02\nend = 0.05 0.02 0.02\nradius = 0.02\n";
     if (shape == Shape::Polygon)
       s << "shape = polygon\nvertices = 0 0, 0.06 0, 0.06 0.04, 0.02 0.05\naxis = z\nfrom = 0\n"
-        << "to = 0.04\n";
+        << "to = 0.03\n";
   }
   if (hold == "clamp") s << "[clamp.root]\nface = x-\n";
   if (hold == "prescribe")

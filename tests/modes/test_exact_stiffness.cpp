@@ -60,7 +60,7 @@ TEST(ExactStiffness, ProbingSavesProductsOnALongBody) {
   // a 3D bar 24 x 4 x 4 with the penalty (the widest stencil, three neighbour hops): far fewer
   // products than unknowns, and still K
   std::string text = bodyText<3>(Shape::Box, {"quadratic", "taylor", 10.0});
-  text.replace(text.find("upper = 0.06"), 12, "upper = 0.24");
+  text.replace(text.find("upper = 0.05"), 12, "upper = 0.24");
   SceneSetup<3> setup = setupOf<3>(text);
   TangentAt<3> t(setup.scene);
   const ExactStiffness e = exactStiffness(t.K, t.solver.reference(), t.dofs, true, 100'000'000);
