@@ -429,7 +429,7 @@ def _sign_changes(v, rel=0.02):
     return int(np.sum(np.sign(big[1:]) != np.sign(big[:-1])))
 
 
-def classify_beam_mode(X, U, axis=0, centre=(0.0, 0.0)):
+def classify_beam_mode(X, U, axis=0, centre=(0.0, 0.0), ends="clamped-free"):
     """Kind and order of a mode shape U (n, 3) of a straight beam along `axis` with its
     section centred at `centre` (the two other coordinates), nodes or particles at X (n, 3).
 
@@ -437,7 +437,9 @@ def classify_beam_mode(X, U, axis=0, centre=(0.0, 0.0)):
     displacement (bending), the mean axial displacement (extension) and the least-squares
     rotation about the axis times the largest radius (torsion); the kind is the largest of the
     three over the sections, the order 1 + the sign changes of that quantity along the beam
-    (a clamped-free beam's k-th mode of a kind has k - 1 interior nodes). Returns
+    (a clamped-free beam's k-th mode of a kind has k - 1 interior nodes). With
+    ends="free-free" the k-th bending mode has k + 1 nodes and the k-th axial or torsion mode k,
+    so the order is the sign changes - 1 (bending) or the sign changes. Returns
     (kind, order, shares) with shares = the three measures' largest values over the sections
     relative to max |U| (about 1 for the mode's own kind, 0 for the others)."""
     X = np.asarray(X, float)
@@ -470,7 +472,10 @@ def classify_beam_mode(X, U, axis=0, centre=(0.0, 0.0)):
         prof = bend @ d
     else:
         prof = ext if kind == "axial" else rot
-    return kind, _sign_changes(prof) + 1, shares
+    changes = _sign_changes(prof)
+    if ends == "free-free":
+        return kind, changes - 1 if kind == "bending" else changes, shares
+    return kind, changes + 1, shares
 
 
 def name_beam_modes(X, modes, **kw):
@@ -518,8 +523,12 @@ def classify_plate_mode(X, U, centre=(0.25, 0.25), normal=2):
 def _beam_mode_values(mesh, modes, case):
     """Frequencies [Hz] by mode name (bending_1, bending_1b, torsion_1, ...), the modes being
     [(frequency, U)] in ascending order; only the modes below the highest complete family are
-    kept (a pair cut off by the number of modes asked for would change names with the mesh)."""
-    names = name_beam_modes(mesh.points, [U for _, U in modes])
+    kept (a pair cut off by the number of modes asked for would change names with the mesh).
+    A free beam's (case["ends"] == "free-free") first `rigid` modes are its rigid-body motions
+    (near-zero frequencies): skipped."""
+    modes = modes[case.get("rigid", 0):]
+    names = name_beam_modes(mesh.points, [U for _, U in modes], ends=case.get("ends",
+                                                                              "clamped-free"))
     vals = {}
     for (f, _), (name, kind, order, shares) in zip(modes, names):
         vals[f"f_{name}"] = f
@@ -645,6 +654,21 @@ CASES = {
              "The tlsph scene's neo-Hookean model linearises to the same elasticity about the "
              "reference state.",
         analytic=_beam_frequency_references),
+    "free_beam_modes": dict(
+        title="3D free beam 1 x 0.1 x 0.1 m (no support): lowest flexible natural frequencies",
+        scene="examples/cantilever.ini", dim=3, analysis="frequency", modes=20, rigid=6,
+        ends="free-free", lower=(0.0, -0.05, -0.05), upper=(1.0, 0.05, 0.05), E=1.0e7, nu=0.3,
+        clamp=[], values=_beam_mode_values, main="f_bending_1",
+        series={
+            "linear": dict(nlgeom=False, vtu=False,
+                           meshes=[(20, 2, 2), (40, 4, 4), (80, 8, 8)]),
+        },
+        note="*FREQUENCY (20 modes, consistent mass), linear elastic, no boundary condition: "
+             "the first 6 modes are the rigid-body motions (near-zero frequencies) and are "
+             "skipped. The tlsph scene is examples/cantilever.ini without its clamp and "
+             "gravity. Modes named by their shapes (classify_beam_mode, ends='free-free'): "
+             "bending_k / bending_kb the degenerate pair of the square section (k-th "
+             "free-free bending, k + 1 nodes), torsion_k, axial_k (k nodes)."),
     "clamped_plate_modes": dict(
         title="3D square plate 0.5 x 0.5 x 0.05 m clamped on its four sides: lowest natural "
               "frequencies",
@@ -770,15 +794,16 @@ def write_inp(path, case, mesh, nlgeom, inc=(1.0, 1.0)):
         for axis, value in case["clamp"]:
             a = "xyz".index(axis)
             clamped |= np.abs(pts[:, a] - value) <= 1e-9 * max(1.0, abs(value))
-        f.write("*NSET, NSET=NCLAMP\n")
-        _write_ids(f, np.nonzero(clamped)[0] + 1)
+        if case["clamp"]:
+            f.write("*NSET, NSET=NCLAMP\n")
+            _write_ids(f, np.nonzero(clamped)[0] + 1)
         f.write(f"*MATERIAL, NAME=M\n*ELASTIC\n{_fmt(case['E'])}, {_fmt(case['nu'])}\n"
                 f"*DENSITY\n{_fmt(RHO0)}\n*SOLID SECTION, ELSET=EALL, MATERIAL=M\n")
-        f.write("*BOUNDARY\n")
+        # a free body (free_beam_modes) has no boundary condition at all
         if case["dim"] == 2:
-            f.write("NALL, 3, 3\nNCLAMP, 1, 2\n")   # plane strain: u_z = 0 everywhere
-        else:
-            f.write("NCLAMP, 1, 3\n")
+            f.write("*BOUNDARY\nNALL, 3, 3\nNCLAMP, 1, 2\n")   # plane strain: u_z = 0
+        elif case["clamp"]:
+            f.write("*BOUNDARY\nNCLAMP, 1, 3\n")
         if case.get("analysis") == "frequency":
             # free vibration: no loads; the eigenvalues go to the .dat, the shapes to the .frd
             f.write(f"*STEP\n*FREQUENCY\n{int(case['modes'])}\n"

@@ -7,6 +7,11 @@ Runs `tlsph modes` on
   rho = 1000 kg/m^3, clamped at x = 0 by mirrored ghosts) at 4, 6, 8, 10 particles through the
   0.1 m side (--scene.dx = 0.1/n), 8 modes: the first bending pair, the second bending pair,
   the first torsion mode, the first axial mode and the third bending pair;
+* the same beam free (validation/scenes/free_beam.ini: no clamp, no load) at 4, 6, 8, 10
+  through, 14 modes: the six rigid-body modes (zero modes by the inertia count, skipped), then
+  the first free-free bending pair, the second bending pair, the first torsion mode and the
+  third bending pair (the first six flexible frequencies and the pair partner of the sixth) and
+  the first axial mode;
 * the clamped plate validation/scenes/clamped_plate.ini (0.5 x 0.5 x 0.05 m, the four side
   faces clamped) at 4 and 6 particles through the 0.05 m thickness, 3 modes: the fundamental
   and the degenerate (2,1)/(1,2) pair. (8 through would factorise a matrix of ~5 GB and take
@@ -16,23 +21,27 @@ Each mode is named from its shape (the frames of NAME_modes.pvd, ghosts left out
 functions that name the FEM modes (validation/fem.py: classify_beam_mode, classify_plate_mode),
 so tlsph's and CalculiX's "bending_2" or "torsion_1" are the same mode even where the order of
 close frequencies differs. References: the FEM frequencies of validation/fem/references.json
-(cases cantilever_modes and clamped_plate_modes: C3D20R mesh ladders, Richardson
-extrapolation; `/usr/bin/python3 validation/fem.py --case cantilever_modes --case
-clamped_plate_modes` recomputes them, ~15 min on one thread), the Timoshenko beam
+(cases cantilever_modes, free_beam_modes and clamped_plate_modes: C3D20R mesh ladders,
+Richardson extrapolation; `/usr/bin/python3 validation/fem.py --case cantilever_modes --case
+free_beam_modes --case clamped_plate_modes` recomputes them, ~15 min on one thread), the
+Timoshenko beam
 (validation/references.py; the second bending frequency from the same determinant, bracketed
 near the Euler-Bernoulli value) and Saint-Venant torsion.
 
 Writes validation/report/frequencies.md (the tables: frequency, error against the converged
 FEM value and against Timoshenko per resolution, the observed order, the penalty share and
-hourglass content of each mode, wall time and peak memory of each run) and
+hourglass content of each mode, wall time and peak memory of each run, and the inertia
+check of each run: zero modes counted by inertia, the list shown complete) and
 validation/report/frequencies.png (relative error against particles through, log-log); the
-runs go to validation/runs/frequencies/ (git-ignored), with summary.json.
+runs go to validation/runs/frequencies/ (git-ignored), with summary.json (each run's record
+from tlsph's modes.json included).
 
   /usr/bin/python3 validation/frequencies.py [--build-dir DIR]   # DIR/tlsph, default build/
   /usr/bin/python3 validation/frequencies.py --tlsph PATH        # a tlsph binary
   /usr/bin/python3 validation/frequencies.py --reuse             # rewrite the report from the
                                                                  # runs already made
-  /usr/bin/python3 validation/frequencies.py --only cantilever   # one problem (or clamped_plate)
+  /usr/bin/python3 validation/frequencies.py --only cantilever   # one problem (or free_beam,
+                                                                 # clamped_plate)
 
 Every run has OMP_NUM_THREADS=1 (--threads to change). Measured cost on this machine: the
 cantilever at 10 through 30 s and 0.7 GB, the plate at 6 through a few minutes and ~3 GB
@@ -75,6 +84,13 @@ PROBLEMS = {
         fem_case="cantilever_modes", kind="beam",
         modes=["bending_1", "bending_1b", "bending_2", "torsion_1", "axial_1", "bending_3"],
         title="3D cantilever 1 x 0.1 x 0.1 m (examples/cantilever.ini)"),
+    "free_beam": dict(
+        scene="validation/scenes/free_beam.ini", side=BEAM_B, through=[4, 6, 8, 10], count=14,
+        fem_case="free_beam_modes", kind="beam", ends="free-free", rigid=6,
+        modes=["bending_1", "bending_1b", "bending_2", "bending_2b", "torsion_1", "bending_3",
+               "bending_3b", "axial_1"],
+        title="3D free beam 1 x 0.1 x 0.1 m (validation/scenes/free_beam.ini: "
+              "examples/cantilever.ini without clamp and load)"),
     "clamped_plate": dict(
         scene="validation/scenes/clamped_plate.ini", side=0.05, through=[4, 6], count=3,
         fem_case="clamped_plate_modes", kind="plate", modes=["mode_1", "mode_2"],
@@ -231,8 +247,19 @@ def run_modes(tlsph, problem, n, threads, reuse):
     rows = read_modes_csv(out / "modes.csv")
     X, shapes = read_mode_shapes(out)
     meta["particles"] = int(len(X))
+    record = out / "modes.json"
+    if record.exists():
+        meta["tlsph_record"] = json.loads(record.read_text())
+    rigid = p.get("rigid", 0)
+    if rigid:
+        # the rigid-body modes (zero modes) are not named; the flexible ones are
+        zero = [r["zero"] for r in rows[:rigid]]
+        if zero != [1] * rigid or any(r["zero"] for r in rows[rigid:]):
+            raise RuntimeError(f"{out}: expected exactly {rigid} zero modes first, got "
+                               f"{[r['zero'] for r in rows]}")
+        rows, shapes = rows[rigid:], shapes[rigid:]
     if p["kind"] == "beam":
-        names = fem.name_beam_modes(X, shapes)
+        names = fem.name_beam_modes(X, shapes, ends=p.get("ends", "clamped-free"))
         for row, (name, kind, order, shares) in zip(rows, names):
             row.update(name=name, kind=kind, order=order,
                        shares={k: round(v, 4) for k, v in shares.items()})
@@ -469,6 +496,22 @@ def build_report(results, beam, fem_refs, fem_recs):
                          + (f"{fc:.5f} | {_pct(row['frequency'] / fc - 1)}" if fc else "- | -")
                          + f" | {row['penalty_share']:.4f} | {row['hourglass_content']:.5f} |")
         L.append("\n</details>\n")
+        checks = []
+        for m in runs:
+            t = m.get("tlsph_record", {})
+            if t.get("inertia_counted"):
+                checks.append(f"{m['through']} through: {t['zero_modes']} zero modes by inertia "
+                              f"({t['rigid_body_modes']} rigid-body), {t['eigenvalues_below_cut']} "
+                              f"eigenvalues below the cut, {t['found_below_cut']} found "
+                              f"({t['lanczos_runs']} Lanczos run(s)); exact K "
+                              f"{t['exact_stiffness']}, L D L^T {t['ldlt_entries'] / 1e6:.1f} M "
+                              f"entries, {t['inertia_seconds']:.0f} s")
+            elif t:
+                checks.append(f"{m['through']} through: no inertia count "
+                              f"({t.get('inertia_not_counted_because', '')}); "
+                              f"{t['zero_modes']} zero modes among the modes found")
+        if checks:
+            L.append("Inertia check (docs/modes.md): " + "; ".join(checks) + ".\n")
         L.append("Runs: " + "; ".join(
             f"{m['through']} through: `{m['command'].replace(str(ROOT) + '/', '')}` "
             f"({m.get('solves', '?')} solves, {m.get('cg_iterations', '?')} CG iterations, "

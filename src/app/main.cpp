@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
@@ -34,9 +35,12 @@ constexpr const char* kUsage = R"(tlsph - total-Lagrangian SPH for elastic solid
 usage:
   tlsph run   SCENE.ini [--section.key=value ...]   run a scene
   tlsph check SCENE.ini [--section.key=value ...]   validate and print the set-up, do not run
-  tlsph modes SCENE.ini [--count=N] [--about=final] [--section.key=value ...]
-                                                    lowest natural modes, zero-energy modes
-                                                    and their hourglass content (docs/modes.md)
+  tlsph modes SCENE.ini [--count=N | --range=FMIN,FMAX] [--about=final]
+        [--section.key=value ...]                   lowest natural modes (or those with a
+                                                    frequency in [FMIN, FMAX] Hz), checked
+                                                    complete by inertia (Sturm count), the
+                                                    zero-energy modes counted by inertia, and
+                                                    their hourglass content (docs/modes.md)
   tlsph compare RUN FEM.vtu [options]               errors against an FEM solution, field by
                                                     field (tlsph compare --help)
   tlsph --help | --version
@@ -58,7 +62,8 @@ run options:
 exit status: 0 finished (or a static run converged), 1 bad input or set-up, 3 a static
 run did not converge, 4 the run went unstable (a [guard] check failed: the message names
 step, particle, quantity and likely cause; NAME_last_good.vtu and NAME_failed.vtu are
-written), 5 (modes) zero-energy modes other than rigid-body motions, 6 an output file could
+written), 5 (modes) zero-energy modes other than rigid-body motions, 7 (modes) the modes
+found could not be shown to be all the eigenvalues below the highest (no list), 6 an output file could
 not be written (disk full, no permission: the message says which, and where the checkpoint
 written on the way out is), 130 / 143 stopped by SIGINT (Ctrl-C) / SIGTERM: a checkpoint,
 the series, a frame and summary.json hold the state at the step it stopped (a second signal
@@ -131,6 +136,7 @@ int tlsphMain(int argc, char** argv, Communicator* comm) {
   for (const auto& a : args)
     command += " " + a;
   ModesOptions modes;
+  bool countGiven = false;
   RunFlags flags;
   flags.sceneFile = args[1];
   for (std::size_t k = 2; k < args.size(); ++k) {
@@ -166,6 +172,26 @@ int tlsphMain(int argc, char** argv, Communicator* comm) {
         return 1;
       }
       modes.settings.count = static_cast<int>(count);
+      countGiven = true;
+    } else if (verb == "modes" && args[k].rfind("--range=", 0) == 0) {
+      const std::string value = args[k].substr(8);
+      const std::size_t comma = value.find(',');
+      auto number = [](const std::string& text, double& out) {
+        char* end = nullptr;
+        out = std::strtod(text.c_str(), &end);
+        return !text.empty() && *end == '\0' && std::isfinite(out);
+      };
+      double low = 0.0, high = 0.0;
+      if (comma == std::string::npos || !number(value.substr(0, comma), low) ||
+          !number(value.substr(comma + 1), high) || low < 0.0 || high <= low) {
+        std::cerr << "tlsph: modes: --range expects FMIN,FMAX in Hz, two numbers with "
+                     "0 <= FMIN < FMAX, got '"
+                  << value << "'\n";
+        return 1;
+      }
+      modes.settings.band = true;
+      modes.settings.lowHz = low;
+      modes.settings.highHz = high;
     } else if (verb == "modes" && args[k].rfind("--about=", 0) == 0) {
       const std::string value = args[k].substr(8);
       if (value != "reference" && value != "final") {
@@ -178,6 +204,11 @@ int tlsphMain(int argc, char** argv, Communicator* comm) {
     }
   }
   flags.overrides = overrides;
+  if (countGiven && modes.settings.band) {
+    std::cerr << "tlsph: modes: --count and --range exclude each other: --count=N lists the N "
+                 "lowest modes, --range=FMIN,FMAX every mode in the band\n";
+    return 1;
+  }
   if (comm && comm->rank() != 0) progress = false;
   try {
     const Config config = Config::read(args[1], overrides);
@@ -199,6 +230,9 @@ int tlsphMain(int argc, char** argv, Communicator* comm) {
                   : runOrCheck<3>(config, verb == "run", progress, command, flags, comm);
   } catch (const InputError& e) {
     std::cerr << "tlsph: " << e.what() << "\n";
+  } catch (const IncompleteModes& e) {
+    std::cerr << "tlsph: " << args[1] << ": modes: " << e.what() << "\n";
+    return 7;
   } catch (const SetupError& e) {
     std::cerr << "tlsph: " << args[1] << ": set-up error: " << e.what() << "\n";
   } catch (const std::exception& e) {
