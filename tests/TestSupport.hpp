@@ -43,8 +43,10 @@ Scene<D> sceneOf(const std::vector<Vec<D>>& X, double dx, double supportRatio, M
   return scene;
 }
 
-// Internal (+ hourglass) forces and strain energy as functions of the displacement field.
-template <int D>
+// Internal (+ hourglass, + viscous with v) forces and strain energy as functions of the
+// displacement field, from the run's fused passes (TlsphForces) or the plain loops
+// (method/PairForces: PlainEvaluator), which share the constructor and compute().
+template <int D, class Forces = TlsphForces<D>>
 class ForceEvaluator {
  public:
   explicit ForceEvaluator(Scene<D> scene)
@@ -54,22 +56,24 @@ class ForceEvaluator {
                                             Kernel<D>(scene_.kernel, scene_.supportRadius),
                                             scene_.periodicBox, scene_.gradientCorrection)),
         forces_(ref_, scene_.materials, scene_.particles.material, scene_.particles.volume,
-                scene_.hourglass(), scene_.quadrature) {}
+                scene_.hourglass(), scene_.quadrature, scene_.viscosity,
+                0.5 * scene_.supportRadius) {}
   ForceEvaluator(const ForceEvaluator&) = delete;
   ForceEvaluator& operator=(const ForceEvaluator&) = delete;
 
   Index size() const { return scene_.particles.size(); }
   const Scene<D>& scene() const { return scene_; }
   const ReferenceConfiguration<D>& reference() const { return ref_; }
-  TlsphForces<D>& forces() { return forces_; }
+  Forces& forces() { return forces_; }
+  const std::vector<Vec<D>>& X() const { return scene_.particles.referencePosition; }
 
-  std::vector<Vec<D>> force(const std::vector<Vec<D>>& u) {
+  std::vector<Vec<D>> force(const std::vector<Vec<D>>& u, const std::vector<Vec<D>>* v = nullptr) {
     std::vector<Vec<D>> f(size());
-    forces_.compute(u, f);
+    forces_.compute(u, f, v);
     return f;
   }
-  // Strain energy plus the energy-form hourglass energy: the total whose negative gradient
-  // is the force.
+  // Strain energy (with the Taylor term) plus the energy-form hourglass energy: the total
+  // whose negative gradient is the force.
   double energy(const std::vector<Vec<D>>& u) {
     force(u);
     return forces_.strainEnergy() + forces_.hourglassEnergy(u);
@@ -84,7 +88,7 @@ class ForceEvaluator {
  private:
   Scene<D> scene_;
   ReferenceConfiguration<D> ref_;
-  TlsphForces<D> forces_;
+  Forces forces_;
 };
 
 template <int D>

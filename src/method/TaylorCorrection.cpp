@@ -1,6 +1,6 @@
 // TaylorCorrection's set-up, compiled once for 2D and 3D: the quadratic fit's moment matrices
-// are inverted here with Eigen's dense eigensolver (the same inverse as the fast pass's, so the
-// two agree to rounding), out of every file that evaluates the forces.
+// are inverted here with Eigen's dense eigensolver, out of every file that evaluates the
+// forces. The fast pass (fast/TaylorQuadrature.cpp) is set up by the same two functions.
 #include "method/TaylorCorrection.hpp"
 
 #include <Eigen/Eigenvalues>
@@ -10,6 +10,64 @@
 namespace tlsph {
 
 template <int D>
+TaylorTermConstants taylorTermConstants(const std::vector<Material>& materials,
+                                        const std::vector<std::uint16_t>& materialOf,
+                                        const std::vector<double>& volume,
+                                        const std::vector<std::uint8_t>& passive) {
+  const std::size_t n = volume.size();
+  TaylorTermConstants c;
+  c.weight.assign(n, 0.0);
+  c.lambda.assign(n, 0.0);
+  c.mu.assign(n, 0.0);
+  c.smallStrain.assign(n, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!passive.empty() && passive[i]) continue;
+    const Material& material = materials[materialOf[i]];
+    const double l = std::pow(volume[i], 1.0 / D);
+    c.weight[i] = l * l / 12.0;
+    c.lambda[i] = elasticConstants(material).lambda;
+    c.mu[i] = elasticConstants(material).mu;
+    c.smallStrain[i] = std::holds_alternative<LinearElastic>(material);
+  }
+  return c;
+}
+
+// The fit through particle i's value, with the offsets scaled by l = V_I^(1/d) for
+// conditioning: u_J - u_I ~ c . p(-X_IJ / l) weighted by V_J W_IJ, so
+// c = M^{-1} sum_J V_J W_IJ p_J (u_J - u_I); the quadratic coefficients give the second
+// derivatives (twice the coefficient on the diagonal, d_a^2 being the monomial).
+template <int D>
+std::vector<Mat<D>> fitSecondDerivatives(const ReferenceConfiguration<D>& ref,
+                                         const std::vector<double>& volume, Index i) {
+  constexpr int T = kQuadraticTerms<D>;
+  using Moment = Eigen::Matrix<double, T, T>;
+  using Basis = Eigen::Matrix<double, T, 1>;
+  const auto& nb = ref.neighbours;
+  const double l = std::pow(volume[i], 1.0 / D);
+  auto basis = [&](Index k) -> Basis { return quadraticBasis<D>(-ref.separation[k] / l); };
+  Moment M = Moment::Zero();
+  for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
+    const Basis p = basis(k);
+    M.noalias() += (volume[nb.neighbour[k]] * ref.kernelValue[k]) * p * p.transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Moment> eigen(M);
+  const Moment Minv = eigen.eigenvectors() * eigen.eigenvalues().cwiseInverse().asDiagonal() *
+                      eigen.eigenvectors().transpose();
+  std::vector<Mat<D>> S(nb.count(i));
+  for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
+    const Basis c = (volume[nb.neighbour[k]] * ref.kernelValue[k]) * (Minv * basis(k));
+    Mat<D>& Sk = S[k - nb.offset[i]];
+    int t = D;  // the quadratic monomials d_a d_b, a <= b, follow the linear ones
+    for (int a = 0; a < D; ++a)
+      for (int b = a; b < D; ++b, ++t) {
+        const double v = c[t] / (l * l);
+        Sk(a, b) = Sk(b, a) = a == b ? 2.0 * v : v;
+      }
+  }
+  return S;
+}
+
+template <int D>
 TaylorCorrection<D>::TaylorCorrection(const ReferenceConfiguration<D>& ref,
                                       const std::vector<Material>& materials,
                                       const std::vector<std::uint16_t>& materialOf,
@@ -17,58 +75,34 @@ TaylorCorrection<D>::TaylorCorrection(const ReferenceConfiguration<D>& ref,
                                       const std::vector<std::uint8_t>& passive)
     : ref_(ref), volume_(volume) {
   const auto& nb = ref.neighbours;
-  const Index n = ref.particleCount();
+  TaylorTermConstants c = taylorTermConstants<D>(materials, materialOf, volume, passive);
+  weight_ = std::move(c.weight);
+  lambda_ = std::move(c.lambda);
+  mu_ = std::move(c.mu);
+  smallStrain_ = std::move(c.smallStrain);
   S_.assign(nb.pairCount(), Mat<D>::Zero());
-  weight_.assign(n, 0.0);
-  lambda_.assign(n, 0.0);
-  mu_.assign(n, 0.0);
-  smallStrain_.assign(n, 0);
-  std::vector<std::uint8_t> fallback(n, 0);
+  std::vector<std::uint8_t> fallback(ref.particleCount(), 0);
   for (Index i : ref.linearFallback)
     fallback[i] = 1;
-  for (Index i = 0; i < n; ++i) {
-    const double l = std::pow(volume[i], 1.0 / D);
-    if (passive.empty() || !passive[i]) {
-      const Material& material = materials[materialOf[i]];
-      weight_[i] = l * l / 12.0;
-      lambda_[i] = elasticConstants(material).lambda;
-      mu_[i] = elasticConstants(material).mu;
-      smallStrain_[i] = std::holds_alternative<LinearElastic>(material);
+  for (Index i = 0; i < ref.particleCount(); ++i)
+    if (ref.correction == GradientCorrection::Quadratic && !fallback[i] && nb.count(i) > 0) {
+      const std::vector<Mat<D>> S = fitSecondDerivatives<D>(ref, volume, i);
+      std::copy(S.begin(), S.end(), S_.begin() + nb.offset[i]);
     }
-    if (ref.correction == GradientCorrection::Quadratic && !fallback[i] && nb.count(i) > 0)
-      fitSecondDerivatives(i, l);
-  }
 }
 
-// The fit of ReferenceConfiguration's quadratic correction through particle i's value, with
-// the offsets scaled by l for conditioning: u_J - u_I ~ c . p(-X_IJ / l) weighted by V_J W_IJ,
-// so c = M^{-1} sum_J V_J W_IJ p_J (u_J - u_I); the quadratic coefficients give the second
-// derivatives (twice the coefficient on the diagonal, d_a^2 being the monomial).
-template <int D>
-void TaylorCorrection<D>::fitSecondDerivatives(Index i, double l) {
-  constexpr int T = kQuadraticTerms<D>;
-  using Moment = Eigen::Matrix<double, T, T>;
-  using Basis = Eigen::Matrix<double, T, 1>;
-  const auto& nb = ref_.neighbours;
-  auto weight = [&](Index k) { return volume_[nb.neighbour[k]] * ref_.kernelValue[k]; };
-  auto basis = [&](Index k) -> Basis { return quadraticBasis<D>(-ref_.separation[k] / l); };
-  Moment M = Moment::Zero();
-  for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k)
-    M += weight(k) * basis(k) * basis(k).transpose();
-  const Eigen::SelfAdjointEigenSolver<Moment> eigen(M);
-  const Moment Minv = eigen.eigenvectors() * eigen.eigenvalues().cwiseInverse().asDiagonal() *
-                      eigen.eigenvectors().transpose();
-  for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
-    const Basis c = weight(k) * (Minv * basis(k));
-    int t = D;  // the quadratic monomials d_a d_b, a <= b, follow the linear ones
-    for (int a = 0; a < D; ++a)
-      for (int b = a; b < D; ++b, ++t) {
-        const double v = c[t] / (l * l);
-        S_[k](a, b) = S_[k](b, a) = a == b ? 2.0 * v : v;
-      }
-  }
-}
-
+template TaylorTermConstants taylorTermConstants<2>(const std::vector<Material>&,
+                                                    const std::vector<std::uint16_t>&,
+                                                    const std::vector<double>&,
+                                                    const std::vector<std::uint8_t>&);
+template TaylorTermConstants taylorTermConstants<3>(const std::vector<Material>&,
+                                                    const std::vector<std::uint16_t>&,
+                                                    const std::vector<double>&,
+                                                    const std::vector<std::uint8_t>&);
+template std::vector<Mat<2>> fitSecondDerivatives<2>(const ReferenceConfiguration<2>&,
+                                                     const std::vector<double>&, Index);
+template std::vector<Mat<3>> fitSecondDerivatives<3>(const ReferenceConfiguration<3>&,
+                                                     const std::vector<double>&, Index);
 template class TaylorCorrection<2>;
 template class TaylorCorrection<3>;
 

@@ -29,13 +29,31 @@
 
 namespace tlsph {
 
+// Per particle: the term's weight c_I = l_I^2 / 12 and its material's small-strain stiffness
+// C0 (lambda, mu); passive particles carry no term (weight 0).
+struct TaylorTermConstants {
+  std::vector<double> weight, lambda, mu;
+  std::vector<std::uint8_t> smallStrain;  // linear-elastic material: e_a = sym(G_a)
+};
+template <int D>
+TaylorTermConstants taylorTermConstants(const std::vector<Material>& materials,
+                                        const std::vector<std::uint16_t>& materialOf,
+                                        const std::vector<double>& volume,
+                                        const std::vector<std::uint8_t>& passive);
+
+// S_IJ of each of particle i's pairs (in its list's order): the second-derivative vectors of the
+// weighted least-squares quadratic fit of ReferenceConfiguration's quadratic correction.
+template <int D>
+std::vector<Mat<D>> fitSecondDerivatives(const ReferenceConfiguration<D>& ref,
+                                         const std::vector<double>& volume, Index i);
+
 template <int D>
 class TaylorCorrection {
  public:
   using Gradients = std::array<Mat<D>, D>;  // G_a = dF/dX_a, a = 0..D-1 (likewise R_a)
 
   // Fits the second-derivative vectors S_IJ (TaylorCorrection.cpp: the fit's moment matrices
-  // are inverted there, compiled once).
+  // are inverted there, compiled once; the fast pass's set-up calls the same functions).
   TaylorCorrection(const ReferenceConfiguration<D>& ref, const std::vector<Material>& materials,
                    const std::vector<std::uint16_t>& materialOf, const std::vector<double>& volume,
                    const std::vector<std::uint8_t>& passive = {});
@@ -145,9 +163,6 @@ class TaylorCorrection {
   }
 
  private:
-  // The quadratic fit's S_IJ of particle i's pairs; l = V_I^(1/d).
-  void fitSecondDerivatives(Index i, double l);
-
   const ReferenceConfiguration<D>& ref_;
   const std::vector<double>& volume_;
   PairArray<Mat<D>> S_;                    // S_IJ, symmetric
