@@ -2,8 +2,8 @@
 // 2D and 3D: the fit's moment matrices are inverted here (Eigen's dense eigensolver), out of every
 // file that includes the force pass. The fit is the one of method/TaylorCorrection.cpp, written
 // again in this unit: compiled elsewhere its rounding differs (contraction into fused
-// multiply-adds), and every run's bits with it. Eigen's small products inlined in the per-particle part of the
-// force pass (stressAt), as in TlsphForces.cpp.
+// multiply-adds), and every run's bits with it. Eigen's small products inlined in the per-particle
+// part of the force pass (stressAt), as in TlsphForces.cpp.
 #ifndef EIGEN_STRONG_INLINE
 #define EIGEN_STRONG_INLINE inline __attribute__((always_inline))
 #endif
