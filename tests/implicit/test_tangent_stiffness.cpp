@@ -99,15 +99,22 @@ struct Matrices {
   std::vector<Mat<D>> diagonal;  // TangentStiffness::diagonalBlocks()
 };
 
+// The free particles moved by a random affine field plus noise; the solver re-evaluated there.
 template <int D>
-Matrices<D> matricesOf(Scene<D>& scene, std::mt19937& rng) {
-  Solver<D> solver(scene);
+void deformRandomly(Scene<D>& scene, Solver<D>& solver, std::mt19937& rng) {
   auto& p = scene.particles;
   const Mat<D> A = randomMatrix<D>(rng, 0.08);
   for (Index i = 0; i < p.size(); ++i)
     if (p.motion[i] == Motion::Free)
       p.displacement[i] = A * p.referencePosition[i] + randomVector<D>(rng, 0.04 * kDx);
   solver.reevaluate();
+}
+
+template <int D>
+Matrices<D> matricesOf(Scene<D>& scene, std::mt19937& rng) {
+  Solver<D> solver(scene);
+  auto& p = scene.particles;
+  deformRandomly(scene, solver, rng);
   DofMap<D> dofs(p, scene.mirrorGhosts);
   TangentStiffness<D> K(solver.reference(), scene.materials, p.material, p.volume,
                         scene.hourglass(), dofs);
@@ -211,11 +218,7 @@ void expectTangentOfThePlainForce(const Case& c, std::uint32_t seed) {
   scene.quadrature = Quadrature::Taylor;
   auto& p = scene.particles;
   Solver<D> solver(scene);
-  const Mat<D> A = randomMatrix<D>(rng, 0.08);
-  for (Index i = 0; i < p.size(); ++i)
-    if (p.motion[i] == Motion::Free)
-      p.displacement[i] = A * p.referencePosition[i] + randomVector<D>(rng, 0.04 * kDx);
-  solver.reevaluate();
+  deformRandomly(scene, solver, rng);
   DofMap<D> dofs(p, scene.mirrorGhosts);
   TangentStiffness<D> K(solver.reference(), scene.materials, p.material, p.volume,
                         scene.hourglass(), dofs, scene.quadrature);
