@@ -4,7 +4,6 @@
 
 #include <vector>
 
-#include "execution/ParallelFor.hpp"
 #include "model/Scene.hpp"
 
 namespace tlsph {
@@ -28,8 +27,8 @@ class ExternalForces {
   void update(double t) {
     const auto& p = scene_->particles;
     const Vec<D> g = scene_->gravity * scene_->gravityRamp.factor(t);
-    // by the threads that read it in the kicks (ParallelFor.hpp)
-    parallelFor(p.size(), [&](Index i) { force_[i] = p.mass[i] * g; });
+    for (Index i = 0; i < p.size(); ++i)
+      force_[i] = p.mass[i] * g;
     for (const auto& load : scene_->loads) {
       const double f = load.ramp.factor(t);
       for (std::size_t k = 0; k < load.particles.size(); ++k)

@@ -18,7 +18,6 @@
 #include "distributed/DistributionPlan.hpp"
 #include "distributed/ReproducibleSum.hpp"
 #include "execution/OrderedSum.hpp"
-#include "execution/ParallelFor.hpp"
 #include "execution/SubnormalsToZero.hpp"
 #include "explicit/Diagnostics.hpp"
 #include "explicit/EnergyBooks.hpp"
@@ -210,12 +209,12 @@ class Solver {
       // The peak test decides the trajectory: its kinetic energy is summed with bits that do
       // not depend on the order, the threads or the ranks (ReproducibleSum.hpp).
       kineticTerms_.resize(ownFree_.size());
-      parallelFor(nFree, [&](Index k) {
+      for (Index k = 0; k < nFree; ++k)
         kineticTerms_[k] = 0.5 * p.mass[ownFree_[k]] * p.velocity[ownFree_[k]].squaredNorm();
-      });
       kinetic = reproducibleSum(kineticTerms_, comm_);
       if (kinetic < previousKinetic_) {  // just past a peak: take the kinetic energy out
-        parallelFor(nFree, [&](Index k) { p.velocity[ownFree_[k]].setZero(); });
+        for (Index k = 0; k < nFree; ++k)
+          p.velocity[ownFree_[k]].setZero();
         work.damping += kinetic;
         kinetic = 0.0;
         ++kineticResets_;
