@@ -3,9 +3,11 @@
 // negative entries in D as K - sigma M has negative eigenvalues, and with M positive definite
 // those are the eigenvalues of (K, M) below sigma). The Sturm-sequence check of FEM
 // eigensolvers: it counts the modes a Lanczos run must have found, independently of that run.
-// Eigen's SimplicialLDLT (fill-reducing AMD ordering, no pivoting: fine for a shift not too
-// close to an eigenvalue, which the callers keep a relative gap from); the symbolic analysis is
-// done once for every shift.
+// With CHOLMOD: its fill-reducing ordering and supernodal symbolic factor, and the Schur
+// complements of the supernodes' dense blocks (Inertia.cpp says why that counts); without it
+// Eigen's SimplicialLDLT (AMD ordering, no pivoting). The symbolic analysis is done once for
+// every shift; a shift on an eigenvalue (an exactly zero pivot) is reported, and the callers
+// keep a relative gap from the eigenvalues.
 #pragma once
 
 #include <Eigen/Core>
@@ -24,7 +26,7 @@ class Inertia {
   Inertia(const Inertia&) = delete;
   Inertia& operator=(const Inertia&) = delete;
 
-  // Entries of the factor L D L^T (its memory), known before any factorisation.
+  // Entries of the factor's blocks (its memory), known before any factorisation.
   long factorNonZeros() const;
   // Eigenvalues of (K, M) below sigma; -1 when the factorisation breaks down (an exactly zero
   // pivot: sigma on an eigenvalue).
