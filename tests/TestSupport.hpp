@@ -129,4 +129,14 @@ inline Material testMaterial(const std::string& name) {
   return makeMaterial(name, ElasticConstants::fromYoungPoisson(2.0e6, 0.3), 1000.0);
 }
 
+// A scene file's text: a 3D rubber beam of 0.1 x 0.1 section along x, clamped at x = 0 (its
+// mirrored face clamp), 4 particles through; `extra` adds sections.
+inline std::string clampedBeamText(double length, const std::string& model = "neo-hookean",
+                                   const std::string& extra = "") {
+  return "[scene]\ndimension = 3\ndx = 0.025\n[material.rubber]\nmodel = " + model +
+         "\ndensity = 1000\nyoungs_modulus = 1.0e7\npoisson_ratio = 0.3\n[body.beam]\nshape = "
+         "box\nlower = 0 -0.05 -0.05\nupper = " +
+         std::to_string(length) + " 0.05 0.05\n[clamp.root]\nface = x-\n[time]\nend = 1\n" + extra;
+}
+
 }  // namespace tlsph::testing

@@ -283,27 +283,8 @@ namespace {
 // of the net force along random directions v, at the undeformed and at a deformed state.
 TEST(TangentStiffness, MatchesFiniteDifferencesOnASceneFileBeam) {
   for (const std::string model : {"linear-elastic", "neo-hookean", "saint-venant-kirchhoff"}) {
-    const std::string text = R"([scene]
-dimension = 3
-dx = 0.025
-[material.rubber]
-model = )" + model + R"(
-density = 1000
-youngs_modulus = 1.0e7
-poisson_ratio = 0.3
-[body.beam]
-shape = box
-lower = 0 -0.05 -0.05
-upper = 0.5 0.05 0.05
-[clamp.root]
-face = x-
-[gravity]
-acceleration = 0 0 -1
-[time]
-end = 1
-[hourglass]
-alpha = 0
-)";
+    const std::string text =
+        clampedBeamText(0.5, model, "[gravity]\nacceleration = 0 0 -1\n[hourglass]\nalpha = 0\n");
     SceneSetup<3> setup = buildScene<3>(Config::parse(text, "beam.ini"));
     Scene<3>& scene = setup.scene;
     Solver<3> solver(scene);

@@ -144,23 +144,7 @@ TEST(Modes, SpuriousModesRankHighestInHourglassContent) {
 }
 
 TEST(Modes, ClampedBeamHasNoZeroModes) {
-  const std::string text = R"([scene]
-dimension = 3
-dx = 0.025
-[material.rubber]
-model = neo-hookean
-density = 1000
-youngs_modulus = 1.0e7
-poisson_ratio = 0.3
-[body.beam]
-shape = box
-lower = 0 -0.05 -0.05
-upper = 1.0 0.05 0.05
-[clamp.root]
-face = x-
-[time]
-end = 1
-)";
+  const std::string text = clampedBeamText(1.0);
   SceneSetup<3> setup = buildScene<3>(Config::parse(text, "beam.ini"));
   const auto r = modesOf(setup.scene, 6);
   EXPECT_EQ(r.zeroModes, 0);
