@@ -14,6 +14,7 @@
 #include <random>
 #include <vector>
 
+#include "app/SpectralLimit.hpp"
 #include "execution/LargePageAllocator.hpp"
 #include "execution/Prefetch.hpp"
 #include "execution/Threads.hpp"
@@ -165,6 +166,9 @@ int main(int argc, char** argv) {
 #else
   Solver<3> solver(scene, {cfl});
 #endif
+  // The scene's default step: the rule, capped by the operator's fastest mode (off the
+  // lattice the cap binds).
+  solver.limitTimeStep(estimateSpectralStep(scene, solver));
   const auto& nb = solver.reference().neighbours;
   std::cout << "particles " << scene.particles.size() << " (" << nx * ny * ny << " body), "
             << "mean neighbours " << double(nb.pairCount()) / nb.particleCount() << ", threads "
@@ -172,6 +176,10 @@ int main(int argc, char** argv) {
             << quadrature << " quadrature, hourglass " << form;
   if (jitter > 0.0) std::cout << ", jitter " << jitter << " dx";
   std::cout << "\n";
+  if (const SpectralStep& cap = solver.spectralStep(); cap.made)
+    std::cout << "step: rule " << solver.stableStepRule().dt << " s, cap 0.8 x 2 / omega_max "
+              << cap.limit << " s (" << cap.products << " products, " << cap.seconds << " s)"
+              << (cap.binds ? ": the cap sets the step" : "") << "\n";
   if (ranks > 1)
     std::cout << "ranks " << ranks << ", partition " << solver.partition().method << ", halo "
               << solver.partition().halo << " particles in all, imbalance "
@@ -208,6 +216,20 @@ int main(int argc, char** argv) {
     std::cerr << "tlsph_bench: the run blew up (tip displacement not finite); its rate is not "
                  "a measurement\n";
     return 1;
+  }
+  {
+    // The energy books: what the undamped run gained or lost against the work of gravity,
+    // relative to its kinetic + strain + hourglass energy (a run's guard stops at 5 %).
+    const EnergyBalance e = solver.energyBalance();
+    const double scale = e.kinetic + e.strain + e.hourglass;
+    const double error = scale > 0.0 ? std::abs(e.total()) / scale : 0.0;
+    std::cout << "energy books: balance " << e.total() << " J of " << scale << " J (" << error
+              << " relative)\n";
+    if (!(error < 0.05)) {
+      std::cerr << "tlsph_bench: the energy books are off by " << error
+                << " of the energy: the run is unstable; its rate is not a measurement\n";
+      return 1;
+    }
   }
   // The roofline: what the force passes must move per particle-step (TlsphForces::traffic),
   // against what a plain copy moves on this machine with the same threads.

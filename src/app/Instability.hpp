@@ -142,15 +142,26 @@ class LikelyCause {
     // b. A time step above the predicted stable step.
     const bool quadratic = setup_.scene.gradientCorrection == GradientCorrection::Quadratic;
     const double cflMax = quadratic ? 0.5 : 0.8;
-    const double stable = solver_.stableStepRule().dt / setup_.solver.cfl * cflMax;
+    const double ruleLimit = solver_.stableStepRule().dt / setup_.solver.cfl * cflMax;
+    // The operator's linear limit, where it was estimated, is the sharper prediction.
+    const SpectralStep& cap = solver_.spectralStep();
+    const double spectralLimit = cap.made ? 2.0 / std::sqrt(cap.lambda) : ruleLimit;
+    const double stable = std::min(ruleLimit, spectralLimit);
     const double dt = solver_.timeStep();
+    const std::string fix = setup_.solver.timeStep > 0.0
+                                ? "lower [time] dt, or drop it for the cfl rule"
+                                : "lower [time] cfl";
+    if (dt > stable && spectralLimit < ruleLimit)
+      return "likely the time step: dt = " + number(dt) + " s is " + number(dt / stable, 3) +
+             " times velocity Verlet's limit 2 / omega_max = " + number(stable) +
+             " s of the operator's fastest mode (omega_max = " + number(std::sqrt(cap.lambda)) +
+             " rad/s at the reference state, largest at particle " + std::to_string(cap.particle) +
+             "): " + fix;
     if (dt > stable)
       return "likely the time step: dt = " + number(dt) + " s is " + number(dt / stable, 3) +
              " times the predicted stable step " + number(stable) +
              " s ([time] cfl = " + number(cflMax) + " for the " +
-             (quadratic ? "quadratic" : "linear") + " correction): " +
-             (setup_.solver.timeStep > 0.0 ? "lower [time] dt, or drop it for the cfl rule"
-                                           : "lower [time] cfl");
+             (quadratic ? "quadratic" : "linear") + " correction): " + fix;
 
     // c. Inverted material next to what drives the body, or squeezed gradually (for an
     // inversion: the smallest J of the last good check was already small, there or next to it).

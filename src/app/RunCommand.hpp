@@ -79,6 +79,7 @@ int runOrCheck(const Config& config, bool run, bool progress, const std::string&
   if (!run) {
     Scene<D> copy = setup.scene;  // the check builds the solver's set-up without running
     Solver<D> solver(copy, setup.solver);
+    applySpectralStep(setup, solver);
     addSolverWarnings(setup, solver, command);
     printSetup(setup, solver);
     return 0;

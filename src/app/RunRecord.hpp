@@ -78,6 +78,13 @@ void writeRunRecord(const std::filesystem::path& file, const SceneSetup<D>& setu
   field("dt_rule_limited_by",
         jsonText(s.stableStep.hourglassSpeed > s.stableStep.waveSpeed ? "hourglass penalty"
                                                                       : "material wave speed"));
+  // The operator's cap (velocity Verlet's linear limit 2 / omega_max times 0.8), null when
+  // none was estimated; dt_spectral_binds: the run's step is the cap.
+  const SpectralStep& cap = s.spectralStep;
+  field("omega_max", cap.made ? jsonNumber(std::sqrt(cap.lambda)) : "null");
+  field("dt_spectral_limit", cap.made ? jsonNumber(cap.limit) : "null");
+  field("dt_spectral_particle", cap.made ? std::to_string(cap.particle) : "null");
+  field("dt_spectral_binds", cap.binds ? "true" : "false");
   field("steps", std::to_string(s.steps));
   field("simulated_time", jsonNumber(s.time));
   field("wall_seconds", jsonNumber(s.wallSeconds));

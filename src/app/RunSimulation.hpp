@@ -18,6 +18,7 @@
 #include "app/Frames.hpp"
 #include "app/Guards.hpp"
 #include "app/RunSeries.hpp"
+#include "app/SpectralLimit.hpp"
 #include "app/StopRequest.hpp"
 #include "explicit/Diagnostics.hpp"
 #include "explicit/Solver.hpp"
@@ -43,7 +44,8 @@ struct RunSummary {
   long steps = 0;
   double time = 0.0;
   double timeStep = 0.0;
-  StableStep stableStep;  // the wave-speed rule's step and what sets it
+  StableStep stableStep;      // the wave-speed rule's step and what sets it
+  SpectralStep spectralStep;  // the operator's cap on it
   double wallSeconds = 0.0;
   double residual = 0.0;
   EnergyBalance energy;
@@ -80,6 +82,7 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
         "the Newton solver ([static] solver = newton) runs on one rank only: start "
         "it without mpirun (or with -np 1), or use solver = damped");
   Solver<D> solver(setup.scene, setup.solver, comm);
+  applySpectralStep(setup, solver);
   onStart(solver);
   if (resume) solver.restore(resume->solver);
   const RunSettings& run = setup.run;
@@ -145,6 +148,7 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
   RunSummary summary;
   summary.timeStep = solver.timeStep();
   summary.stableStep = solver.stableStepRule();
+  summary.spectralStep = solver.spectralStep();
   RunGuard<D> guard(setup, solver);  // the stability guards (Guards.hpp)
   if (resume) {
     // The output as it was at the checkpoint: later rows and frames (written before the stop)

@@ -98,6 +98,20 @@ void printSetup(const SceneSetup<D>& setup, const Solver<D>& solver) {
               << (rule.hourglassSpeed > rule.waveSpeed ? "hourglass penalty"
                                                        : "material wave speed")
               << "\n";
+    // The operator's cap: 0.8 x 2 / omega_max (method/TimeStep.hpp).
+    const SpectralStep& cap = solver.spectralStep();
+    if (cap.made) {
+      const Vec<D> Y = p.referencePosition[cap.particle];
+      std::cout << "spectrum     omega_max = " << std::sqrt(cap.lambda) << " rad/s (Lanczos, "
+                << cap.products << " products K v), largest at particle " << cap.particle << " ("
+                << Y.transpose() << "); cap 0.8 x 2 / omega_max = " << cap.limit << " s"
+                << (cap.binds ? ": it sets the step (the operator is stiffer than the rule "
+                                "predicts)"
+                              : " (the rule's step is below it)")
+                << "\n";
+    } else if (!cap.why.empty()) {
+      std::cout << "spectrum     no cap on the step: " << cap.why << "\n";
+    }
   }
   std::cout << "output       " << setup.output.directory << "/";
   if (setup.output.fields.empty()) {

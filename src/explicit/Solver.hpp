@@ -36,6 +36,9 @@ namespace tlsph {
 struct SolverSettings {
   double cfl = kDefaultCfl;
   double timeStep = 0.0;  // > 0 overrides the wave-speed rule
+  // Cap the rule's step at the operator's own limit (method/TimeStep.hpp spectralStepLimit);
+  // off only to measure the rule alone (the stability map).
+  bool spectralLimit = true;
 };
 
 template <int D>
@@ -65,6 +68,7 @@ class Solver {
       stable_ = stableStep(p, scene.materials, settings.cfl, forces_.hourglassStiffness());
     }
     dt_ = settings.timeStep > 0.0 ? settings.timeStep : stable_.dt;
+    stepGiven_ = settings.timeStep > 0.0;
     for (Index i = 0; i < p.size(); ++i)
       if (p.motion[i] == Motion::Free) free_.push_back(i);
     prescribed_ = PrescribedParticles<D>(scene);
@@ -123,6 +127,14 @@ class Solver {
 
   double time() const { return time_; }
   double timeStep() const { return dt_; }
+  // Before the first step: the step becomes min(rule, cap.limit) unless [time] dt was given.
+  void limitTimeStep(SpectralStep cap) {
+    cap.binds = !stepGiven_ && cap.made && cap.limit < dt_;
+    if (cap.binds) dt_ = cap.limit;
+    spectral_ = std::move(cap);
+  }
+  // The cap and whether it binds; made = false when none was estimated.
+  const SpectralStep& spectralStep() const { return spectral_; }
   // The wave-speed rule's step at the run's C_cfl and what sets it (also when [time] dt
   // overrides it).
   const StableStep& stableStepRule() const { return stable_; }
@@ -458,6 +470,8 @@ class Solver {
   ExternalForces<D> loads_;
   StableStep stable_;
   double dt_ = 0.0;
+  bool stepGiven_ = false;
+  SpectralStep spectral_;
   double time_ = 0.0;
   long steps_ = 0;
   double previousKinetic_ = 0.0;

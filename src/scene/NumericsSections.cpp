@@ -84,6 +84,7 @@ void Builder<D>::readTimeAndDamping() {
   SectionReader t(config_, "time");
   setup_.solver.cfl = t.positive("cfl", kDefaultCfl);
   setup_.solver.timeStep = t.nonNegative("dt", 0.0);
+  setup_.solver.spectralLimit = t.flag("spectral_limit", true);
   // A Newton static run has no time to march; `end` only scales the default output interval.
   setup_.run.endTime =
       newton && setup_.run.quasiStatic ? t.positive("end", 1.0) : t.positive("end");
