@@ -15,37 +15,26 @@
 namespace tlsph {
 
 template <int D>
-SpectralStep estimateSpectralStep(const Scene<D>& scene, const Solver<D>& solver) {
-  SpectralStep cap;
-  HighestFrequency f;
+SpectralEstimate estimateSpectralStep(const Scene<D>& scene, const Solver<D>& solver) {
   Communicator* comm = solver.communicator();
-  if (!comm) {
-    f = highestFrequency(scene, solver.reference());
-  } else {
-    std::vector<double> numbers(4, 0.0);
-    if (comm->rank() == 0) {
-      const auto whole =
-          buildReferenceConfiguration<D>(scene.particles.referencePosition, scene.particles.volume,
-                                         Kernel<D>(scene.kernel, scene.supportRadius),
-                                         scene.periodicBox, scene.gradientCorrection);
-      f = highestFrequency(scene, whole);
-      numbers = {f.made ? 1.0 : 0.0, f.lambda, double(f.particle), double(f.products)};
-    }
-    comm->broadcast(numbers);
-    comm->broadcast(f.why);
-    f.made = numbers[0] != 0.0;
-    f.lambda = numbers[1];
-    f.particle = Index(numbers[2]);
-    f.products = int(numbers[3]);
+  if (!comm) return highestFrequency(scene, solver.reference());
+  SpectralEstimate f;
+  std::vector<double> numbers(5, 0.0);
+  if (comm->rank() == 0) {
+    const auto whole = buildReferenceConfiguration<D>(
+        scene.particles.referencePosition, scene.particles.volume,
+        Kernel<D>(scene.kernel, scene.supportRadius), scene.periodicBox, scene.gradientCorrection);
+    f = highestFrequency(scene, whole);
+    numbers = {f.made ? 1.0 : 0.0, f.lambda, double(f.particle), double(f.products), f.seconds};
   }
-  cap.made = f.made;
-  cap.why = f.why;
-  cap.lambda = f.lambda;
-  cap.particle = f.particle;
-  cap.products = f.products;
-  cap.seconds = f.seconds;
-  if (f.made) cap.limit = spectralStepLimit(f.lambda);
-  return cap;
+  comm->broadcast(numbers);
+  comm->broadcast(f.why);
+  f.made = numbers[0] != 0.0;
+  f.lambda = numbers[1];
+  f.particle = Index(numbers[2]);
+  f.products = int(numbers[3]);
+  f.seconds = numbers[4];
+  return f;
 }
 
 // What a run or a check applies: nothing for a Newton static run (no time step) or with

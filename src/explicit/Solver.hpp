@@ -127,11 +127,13 @@ class Solver {
 
   double time() const { return time_; }
   double timeStep() const { return dt_; }
-  // Before the first step: the step becomes min(rule, cap.limit) unless [time] dt was given.
-  void limitTimeStep(SpectralStep cap) {
-    cap.binds = !stepGiven_ && cap.made && cap.limit < dt_;
-    if (cap.binds) dt_ = cap.limit;
-    spectral_ = std::move(cap);
+  // Before the first step: the step becomes min(rule, spectralStepLimit) unless [time] dt was
+  // given.
+  void limitTimeStep(const SpectralEstimate& estimate) {
+    spectral_ = SpectralStep{estimate};
+    if (estimate.made) spectral_.limit = spectralStepLimit(estimate.lambda);
+    spectral_.binds = !stepGiven_ && estimate.made && spectral_.limit < dt_;
+    if (spectral_.binds) dt_ = spectral_.limit;
   }
   // The cap and whether it binds; made = false when none was estimated.
   const SpectralStep& spectralStep() const { return spectral_; }

@@ -82,16 +82,22 @@ inline double spectralStepLimit(double lambdaMax) {
                          : std::numeric_limits<double>::infinity();
 }
 
-// The cap as a run applies it.
-struct SpectralStep {
+// The operator's highest frequency at the reference state (modes/HighestFrequency.hpp).
+struct SpectralEstimate {
   bool made = false;    // an estimate was made (else `why`)
   std::string why;      // completes "no spectral limit: "
   double lambda = 0.0;  // omega_max^2 [1/s^2]
-  Index particle = -1;  // the largest amplitude in the fastest mode
+  Index particle = -1;  // the largest amplitude in the fastest mode (where the stiffness sits)
+  int products = 0;     // products K v the estimate took
+  double seconds = 0.0;
+  // Velocity Verlet's critical step 2 / omega_max (0 when not made).
+  double criticalStep() const { return made && lambda > 0.0 ? 2.0 / std::sqrt(lambda) : 0.0; }
+};
+
+// The cap as a run applies it.
+struct SpectralStep : SpectralEstimate {
   double limit = std::numeric_limits<double>::infinity();  // spectralStepLimit(lambda)
   bool binds = false;  // the run's step is the cap, not the rule
-  int products = 0;    // products K v the estimate took
-  double seconds = 0.0;
 };
 
 template <int D>

@@ -40,9 +40,9 @@ class ScaledStiffness {
 }  // namespace
 
 template <int D>
-HighestFrequency highestFrequency(const Scene<D>& scene, const ReferenceConfiguration<D>& ref,
+SpectralEstimate highestFrequency(const Scene<D>& scene, const ReferenceConfiguration<D>& ref,
                                   double relativeTolerance) {
-  HighestFrequency result;
+  SpectralEstimate result;
   const auto start = std::chrono::steady_clock::now();
   const auto& hourglass = scene.hourglass();
   if (hourglass.enabled() && hourglass.form != HourglassForm::Energy) {
@@ -100,9 +100,9 @@ HighestFrequency highestFrequency(const Scene<D>& scene, const ReferenceConfigur
   return result;
 }
 
-template HighestFrequency highestFrequency<2>(const Scene<2>&, const ReferenceConfiguration<2>&,
+template SpectralEstimate highestFrequency<2>(const Scene<2>&, const ReferenceConfiguration<2>&,
                                               double);
-template HighestFrequency highestFrequency<3>(const Scene<3>&, const ReferenceConfiguration<3>&,
+template SpectralEstimate highestFrequency<3>(const Scene<3>&, const ReferenceConfiguration<3>&,
                                               double);
 
 }  // namespace tlsph

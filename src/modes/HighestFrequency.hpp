@@ -13,32 +13,22 @@
 #include <string>
 
 #include "method/ReferenceConfiguration.hpp"
+#include "method/TimeStep.hpp"
 #include "model/Scene.hpp"
 #include "model/Types.hpp"
 
 namespace tlsph {
 
-struct HighestFrequency {
-  bool made = false;
-  std::string why;      // when not made: why (the text completes "no spectral estimate: ")
-  double lambda = 0.0;  // omega_max^2 [1/s^2]
-  // The particle with the largest amplitude in the fastest mode (where the stiffness sits).
-  Index particle = -1;
-  int products = 0;  // products K v taken
-  double seconds = 0.0;
-  double criticalStep() const { return made && lambda > 0.0 ? 2.0 / std::sqrt(lambda) : 0.0; }
-};
-
 // ref: the whole body's reference configuration (every particle with its list). Not made for
 // the textbook hourglass force (not the gradient of an energy: no symmetric K) or a scene with
 // nothing free to move. relativeTolerance: Lanczos' convergence bar on lambda_max.
 template <int D>
-HighestFrequency highestFrequency(const Scene<D>& scene, const ReferenceConfiguration<D>& ref,
+SpectralEstimate highestFrequency(const Scene<D>& scene, const ReferenceConfiguration<D>& ref,
                                   double relativeTolerance = 1e-4);
 
-extern template HighestFrequency highestFrequency<2>(const Scene<2>&,
+extern template SpectralEstimate highestFrequency<2>(const Scene<2>&,
                                                      const ReferenceConfiguration<2>&, double);
-extern template HighestFrequency highestFrequency<3>(const Scene<3>&,
+extern template SpectralEstimate highestFrequency<3>(const Scene<3>&,
                                                      const ReferenceConfiguration<3>&, double);
 
 }  // namespace tlsph

@@ -1,4 +1,4 @@
-// The highest frequency of the discrete operator (HighestFrequency) and the explicit step's cap
+// The highest frequency of the discrete operator (highestFrequency) and the explicit step's cap
 // on it: Lanczos' omega_max^2 is the largest eigenvalue of the dense generalised problem
 // K phi = lambda M phi on jittered 2D and 3D blocks (both corrections, both quadratures,
 // penalty on and off, free and clamped); and it is the stability limit of the explicit step:
@@ -60,7 +60,7 @@ void expectDenseLargest(double jitter) {
   for (const auto& n : kNumerics) {
     Scene<D> scene = jitteredBlock<D>(n, jitter, 7);
     Solver<D> solver(scene);
-    const HighestFrequency f = highestFrequency(scene, solver.reference(), 1e-8);
+    const SpectralEstimate f = highestFrequency(scene, solver.reference(), 1e-8);
     ASSERT_TRUE(f.made) << f.why;
     const double dense = denseLargest<D>(scene);
     EXPECT_NEAR(f.lambda, dense, 1e-7 * dense) << D << "D " << n.correction << " " << n.quadrature
@@ -83,7 +83,7 @@ TEST(HighestFrequency, SeesThroughClampsAndHeldParticles) {
   for (const char* hold : {"clamp", "prescribe"}) {
     SceneSetup<2> setup = setupOf<2>(bodyText<2>(Shape::Box, {"quadratic", "taylor", 10.0}, hold));
     Solver<2> solver(setup.scene);
-    const HighestFrequency f = highestFrequency(setup.scene, solver.reference(), 1e-8);
+    const SpectralEstimate f = highestFrequency(setup.scene, solver.reference(), 1e-8);
     ASSERT_TRUE(f.made) << f.why;
     EXPECT_NEAR(f.lambda, denseLargest<2>(setup.scene), 1e-7 * f.lambda) << hold;
   }
@@ -93,7 +93,7 @@ TEST(HighestFrequency, NotMadeForTheTextbookForce) {
   Scene<2> scene = jitteredBlock<2>({"quadratic", "taylor", 10.0}, 0.0, 7);
   scene.hourglassForm = HourglassForm::Ganzenmueller;
   Solver<2> solver(scene);
-  const HighestFrequency f = highestFrequency(scene, solver.reference());
+  const SpectralEstimate f = highestFrequency(scene, solver.reference());
   EXPECT_FALSE(f.made);
   EXPECT_NE(f.why.find("not the gradient of an energy"), std::string::npos) << f.why;
 }
@@ -108,7 +108,7 @@ double energyErrorAt(double factor, const Numerics& n) {
   for (auto& v : scene.particles.velocity)
     for (int a = 0; a < D; ++a)
       v[a] = 1e-4 * unit(rng);
-  const HighestFrequency f = [&] {
+  const SpectralEstimate f = [&] {
     Solver<D> s(scene);
     return highestFrequency(scene, s.reference(), 1e-8);
   }();
