@@ -14,9 +14,14 @@
 //                     linear geometry (MeshedBody::curved == false)
 //
 // gmsh is one global state: meshBody initialises and finalises it around each call, and is not
-// reentrant (a second call while one runs, from another thread, throws GeometryError). Nothing
-// is written to disk by meshBody itself; a .geo script is run as given (a `Save` command in it
-// would write).
+// reentrant (a second call while one runs, from another thread, throws GeometryError). The
+// caller's locale and OpenMP thread count, which gmsh::initialize changes, are put back.
+//
+// Nothing is written to disk by meshBody or gmsh's meshing, with two exceptions outside our
+// control: a .geo script is run as given (a `Save` command in it would write), and Debian's gmsh
+// 4.8.4, built with FLTK, rewrites FLTK's preference files at every gmsh::initialize
+// (~/.fltk/fltk.org/fltk.prefs, and /etc/fltk/fltk.org/fltk.prefs when run as root; an empty
+// 94-byte file, created on first use).
 #pragma once
 
 #include <array>

@@ -13,6 +13,7 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <clocale>
 #include <cmath>
@@ -24,6 +25,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #ifdef _OPENMP
@@ -458,7 +460,9 @@ std::set<std::filesystem::path> listing(const std::filesystem::path& dir) {
   return files;
 }
 
-TEST(GmshBodyProcess, LeavesThreadsLocaleDirectoryAndDiskAlone) {
+// (Not checked: the FLTK preference files Debian's gmsh rewrites at initialisation, see
+// GmshBody.hpp.)
+TEST(GmshBodyProcess, LeavesThreadsLocaleAndDirectoriesAlone) {
   const std::string locale = std::setlocale(LC_ALL, nullptr);
   const auto cwd = std::filesystem::current_path();
   const auto here = listing(cwd), there = listing(TLSPH_GEOMETRY_DATA);
@@ -474,6 +478,36 @@ TEST(GmshBodyProcess, LeavesThreadsLocaleDirectoryAndDiskAlone) {
   EXPECT_EQ(std::filesystem::current_path(), cwd);
   EXPECT_EQ(listing(cwd), here);
   EXPECT_EQ(listing(TLSPH_GEOMETRY_DATA), there);
+}
+
+// One call at a time: a call while another runs is refused, not run on gmsh's shared state.
+TEST(GmshBodyProcess, ConcurrentCallsAreRefused) {
+  std::atomic<bool> done{false};
+  std::atomic<int> refused{0};
+  auto refusal = [&](const GeometryError& e) {
+    if (std::string(e.what()).find("gmsh is in use by another meshBody call") == std::string::npos)
+      ADD_FAILURE() << e.what();
+    ++refused;
+  };
+  std::thread worker([&] {
+    try {
+      const auto body = meshBody<3>(data("box_hole.geo"), 0.2);
+      EXPECT_GT(body.position.size(), 1000u);
+    } catch (const GeometryError& e) {
+      refusal(e);
+    }
+    done = true;
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));  // the worker first, mostly
+  while (!done) {
+    try {
+      meshBody<2>(data("ring.geo"), 1.0);
+    } catch (const GeometryError& e) {
+      refusal(e);
+    }
+  }
+  worker.join();
+  EXPECT_GE(refused.load(), 1);
 }
 
 // ----------------------------------------------------------------------------------------------
