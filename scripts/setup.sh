@@ -20,7 +20,7 @@ build_dir="${BUILD_DIR:-build}"
 jobs="${JOBS:-$(nproc)}"
 
 packages=(cmake make g++ libeigen3-dev libboost-program-options-dev libvtk9-dev libsuitesparse-dev libopenblas0-pthread libspectra-dev libmetis-dev libopenmpi-dev openmpi-bin
-  libgtest-dev googletest python3)
+  libgtest-dev googletest python3 libgmsh-dev gmsh)
 # The validation report's plots need numpy and matplotlib (the quick check under ctest does not;
 # the FEM VTU self-test under ctest needs numpy).
 if [ "$action" = test ]; then
