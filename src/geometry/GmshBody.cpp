@@ -701,6 +701,7 @@ MeshedBody<D> meshBody(const std::string& path, double size, const MeshOptions& 
     }
     typename MeshedBody<D>::Surface surface;
     std::map<Index, double> areaOf;
+    std::map<Index, Vec<D>> areaVectorOf;
     for (const auto& entityBlocks : groupBlocks)
       for (const auto& block : entityBlocks) {
         const ElementRule& r = rule(block.type, true);
@@ -740,17 +741,22 @@ MeshedBody<D> meshBody(const std::string& path, double size, const MeshOptions& 
             facetCentre += body.position[p];
           facetCentre /= static_cast<double>(corner.size());
           const Vec<D> out = facetCentre - cellCentre;
-          auto addFacet = [&](std::array<Index, D> f) {
-            Vec<D> normal;
+          auto linearNormal = [&](const std::array<Index, D>& f) {
             const Vec<D> a = body.position[f[1]] - body.position[f[0]];
-            if constexpr (D == 2) {
-              normal = Vec<D>(a.y(), -a.x());
-            } else {
-              normal = a.cross(body.position[f[2]] - body.position[f[0]]);
-            }
-            if (normal.dot(out) < 0) std::swap(f[0], f[1]);
+            if constexpr (D == 2)
+              return Vec<D>(a.y(), -a.x());
+            else
+              return Vec<D>(a.cross(body.position[f[2]] - body.position[f[0]]));
+          };
+          auto addFacet = [&](std::array<Index, D> f) {
+            if (linearNormal(f).dot(out) < 0) std::swap(f[0], f[1]);
             surface.facets.push_back(f);
           };
+          // gmsh's corner order gives the curved facet's normal below (3D: dx/du x dx/dv, 2D:
+          // dx/du turned by -90 degrees) the orientation of the linear one: flip it if inward.
+          std::array<Index, D> gmshOrder;
+          std::copy_n(corner.begin(), D, gmshOrder.begin());
+          const double outward = linearNormal(gmshOrder).dot(out) < 0 ? -1.0 : 1.0;
           if constexpr (D == 2) {
             addFacet({corner[0], corner[1]});
           } else {
@@ -762,21 +768,34 @@ MeshedBody<D> meshBody(const std::string& path, double size, const MeshOptions& 
           for (int a = 0; a < r.nodes; ++a)
             x[a] = nodes(block.nodes[e * r.nodes + a]);
           std::vector<double> nodeArea(r.corners, 0.0);
+          std::vector<Vec<D>> nodeAreaVector(r.corners, Vec<D>::Zero());
           for (std::size_t q = 0; q < r.points(); ++q) {
             Vec3 c[3];
             jacobian(r, q, x, c);
             const double da = facetDensity(r.dim, c) * r.weight[q];
+            Vec<D> nda;
+            if constexpr (D == 2)
+              nda = Vec<D>(c[0].y(), -c[0].x());
+            else
+              nda = c[0].cross(c[1]);
+            nda *= outward * r.weight[q];
             surface.measure += da;
-            for (int a = 0; a < r.corners; ++a)
+            for (int a = 0; a < r.corners; ++a) {
               nodeArea[a] += r.hat[q * r.corners + a] * da;
+              nodeAreaVector[a] += r.hat[q * r.corners + a] * nda;
+            }
           }
-          for (int a = 0; a < r.corners; ++a)
+          for (int a = 0; a < r.corners; ++a) {
             areaOf[corner[a]] += nodeArea[a];
+            // (Eigen's vectors start uninitialised: insert a zero, then add.)
+            areaVectorOf.try_emplace(corner[a], Vec<D>::Zero()).first->second += nodeAreaVector[a];
+          }
         }
       }
     for (const auto& [p, a] : areaOf) {
       surface.nodes.push_back(p);
       surface.area.push_back(a);
+      surface.areaVector.push_back(areaVectorOf.at(p));
     }
     body.surfaces[name] = std::move(surface);
   }

@@ -94,6 +94,10 @@ struct MeshedBody {
     std::vector<std::array<Index, D>> facets;
     // Per particle of `nodes`: A_I = int_S lambda_I dA on the curved (order-2) surface.
     std::vector<double> area;
+    // Per particle of `nodes`: a_I = int_S lambda_I n dA, n the outward unit normal of the curved
+    // surface: the particle's share of the vector area, so that a pressure p puts -p a_I on it
+    // and the shares of a closed surface sum to zero (up to rounding).
+    std::vector<Vec<D>> areaVector;
     std::vector<Index> nodes;  // the particles on this surface (sorted, unique)
     // The surface's area (2D: length), integrated element by element on the curved geometry;
     // equals the sum of `area` by partition of unity.
