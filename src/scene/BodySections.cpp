@@ -68,10 +68,16 @@ void Builder<D>::fillBodies() {
   if (names.empty())
     throw InputError(config_.origin(), "body.NAME", "",
                      "the scene needs at least one [body.NAME] section");
+  if (freeFormBodyGiven()) {
+    fillFreeFormBody();
+    return;
+  }
   std::vector<Shape<D>> shapes;
   std::vector<std::uint16_t> materialOfBody;
   for (const auto& name : names) {
     SectionReader r(config_, "body." + name);
+    // Listed with the shapes read from files (FreeFormBodies.cpp) for the error's choices.
+    r.word("shape", std::nullopt, {"box", "cylinder", "ball", "polygon", "particles", "mesh"});
     shapes.push_back(readShape<D>(r, false));
     materialOfBody.push_back(materialIndex(r));
     r.finish();
@@ -182,17 +188,38 @@ void Builder<D>::readRegions() {
   const auto& X = setup_.scene.particles.referencePosition;
   std::vector<Vec<D>> bodyX(static_cast<std::size_t>(bodyCount_));
   for (Index i = 0; i < bodyCount_; ++i)
-    bodyX[i] = testedPoint<D>(lattice_, X[i], setup_.dx);
+    bodyX[i] = setup_.freeForm ? X[i] : testedPoint<D>(lattice_, X[i], setup_.dx);
   for (const auto& name : config_.namesOf("region")) {
     SectionReader r(config_, "region." + name);
     if (name == "all") throw r.error("", "'all' is a built-in region (every body particle)");
+    // A mesh body's named surface or volume (its physical groups).
+    if (r.has("surface")) {
+      setup_.regions[name] = namedSurface(r).particles;
+      r.finish();
+      continue;
+    }
+    if (r.has("volume")) {
+      std::vector<std::string> known;
+      for (const auto& [group, list] : freeFormVolumes_)
+        known.push_back(group);
+      if (known.empty())
+        throw r.error("volume",
+                      "the scene has no named volume: volumes are the physical groups "
+                      "of dimension " +
+                          std::to_string(D) +
+                          " of a body meshed from a CAD or mesh file (shape = mesh)");
+      setup_.regions[name] = freeFormVolumes_.at(r.word("volume", std::nullopt, known));
+      r.finish();
+      continue;
+    }
     const Shape<D> shape = readShape<D>(r, true);
     r.finish();
     auto selected = select(shape, bodyX);
     if (selected.empty())
-      throw r.error("shape",
-                    "the region selects no particle (particles sit at cell centres "
-                    "(n + 1/2) dx; make the region at least one dx thick)");
+      throw r.error("shape", setup_.freeForm
+                                 ? "the region selects no particle"
+                                 : "the region selects no particle (particles sit at cell centres "
+                                   "(n + 1/2) dx; make the region at least one dx thick)");
     setup_.regions[name] = std::move(selected);
   }
 }

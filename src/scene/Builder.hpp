@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <map>
+#include <set>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -112,10 +113,17 @@ class Builder {
   const Eigen::AlignedBox<double, D>& bodyBox();
   bool onBoundingFace(Index i, const std::string& face);
 
+  // A body read from a particle file or meshed from a CAD or mesh file, the scene's only body
+  // (FreeFormBodies.cpp); the named surfaces conditions refer to.
+  bool freeFormBodyGiven() const;
+  void fillFreeFormBody();
+  const SurfacePatch<D>& namedSurface(SectionReader& r, const std::string& key = "surface");
+
   // [clamp.NAME], [prescribe.NAME] (ConditionSections.cpp).
   void addClamps();
   std::string readMotion(SectionReader& r, Prescription<D>& rule);
   static std::string motionText(const Prescription<D>& rule);
+  void addNodalClamp(SectionReader& r, const std::string& name, std::set<std::string>& facesUsed);
   void readPrescriptions();
 
   // [gravity], [load.NAME], [initial.NAME] (LoadSections.cpp).
@@ -137,6 +145,8 @@ class Builder {
   Index bodyCount_ = 0;
   std::map<std::array<long, D>, Index> latticeIndex_;  // lattice point -> body particle
   std::array<LatticeAxis, D> lattice_{};               // the bodies' lattice
+  // A mesh body's physical groups of dimension d: their particles, for regions.
+  std::map<std::string, std::vector<Index>> freeFormVolumes_;
   // Body particles a clamp holds (its face layer, or the layers its ghosts mirror): the clamp's
   // name and what it does, for the error when a [prescribe] region takes one of them too.
   std::map<Index, std::pair<std::string, std::string>> clampHeld_;

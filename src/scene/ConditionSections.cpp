@@ -17,6 +17,15 @@ void Builder<D>::addClamps() {
   std::set<std::string> facesUsed;
   for (const auto& name : config_.namesOf("clamp")) {
     SectionReader r(config_, "clamp." + name);
+    if (setup_.freeForm) {
+      addNodalClamp(r, name, facesUsed);
+      continue;
+    }
+    if (r.has("surface"))
+      throw r.error("surface",
+                    "named surfaces belong to a body meshed from a CAD or mesh file (shape = "
+                    "mesh); a lattice body is clamped on a face of its bounding box (face = x-, "
+                    "...)");
     const std::string face = r.word("face", std::nullopt, faceNames());
     if (!facesUsed.insert(face).second) throw r.error("face", "face " + face + " is clamped twice");
     const std::string method = r.word("method", "mirror", {"mirror", "mirror-quadratic", "fixed"});
@@ -131,6 +140,58 @@ void Builder<D>::addClamps() {
   }
 }
 
+// A clamp on a body read from a file: its particles on the named surface (or on a face of the
+// bounding box) are held, following the clamp's motion. A mesh body's surface particles lie on
+// the surface, so u = u_p holds on the surface itself; there are no ghosts (mirroring needs the
+// lattice's layers).
+template <int D>
+void Builder<D>::addNodalClamp(SectionReader& r, const std::string& name,
+                               std::set<std::string>& facesUsed) {
+  auto& p = setup_.scene.particles;
+  const std::string method =
+      r.word("method", "nodal", {"nodal", "mirror", "mirror-quadratic", "fixed"});
+  if (method != "nodal")
+    throw r.error("method",
+                  "a body read from a file (shape = particles or mesh) is clamped at "
+                  "its particles on the surface (method = nodal): '" +
+                      method + "' needs the lattice's layers behind a face");
+  std::vector<Index> held;
+  std::string where;
+  if (r.has("surface")) {
+    if (r.has("face")) throw r.error("face", "give either face or surface, not both");
+    const std::string surface = config_.get("clamp." + name, "surface");
+    held = namedSurface(r).particles;
+    if (!facesUsed.insert("surface " + surface).second)
+      throw r.error("surface", "surface " + surface + " is clamped twice");
+    where = "surface " + surface;
+  } else {
+    const std::string face = r.word("face", std::nullopt, faceNames());
+    if (!facesUsed.insert(face).second) throw r.error("face", "face " + face + " is clamped twice");
+    for (Index i = 0; i < bodyCount_; ++i)
+      if (onBoundingFace(i, face)) held.push_back(i);
+    where = "face " + face;
+  }
+  Prescription<D> clamp;
+  clamp.name = "clamp." + name;
+  const std::string motion = readMotion(r, clamp);
+  r.finish();
+  for (Index i : held) {
+    if (const auto c = clampHeld_.find(i); c != clampHeld_.end())
+      throw r.error(r.has("surface") ? "surface" : "face",
+                    "particle " + std::to_string(i) + " at " + fmt<D>(p.referencePosition[i]) +
+                        " is held by [clamp." + c->second.first +
+                        "] too: clamps that share particles (surfaces meeting at an edge) would "
+                        "hold them twice; clamp the union as one surface in the CAD model");
+    clampHeld_.emplace(i, std::pair{name, "holds " + where});
+    p.motion[i] = Motion::Prescribed;
+  }
+  clamp.particles = held;
+  setup_.conditions.push_back("clamp." + name + ": " + where + ", nodal, " +
+                              (motion == "fixed" ? "" : motion + " " + motionText(clamp) + ", ") +
+                              std::to_string(held.size()) + " particles held");
+  setup_.scene.prescriptions.push_back(std::move(clamp));
+}
+
 // The `motion` of a prescription or a clamp and its keys; returns the motion's name.
 template <int D>
 std::string Builder<D>::readMotion(SectionReader& r, Prescription<D>& rule) {
@@ -193,6 +254,8 @@ void Builder<D>::readPrescriptions() {
 }
 
 template void Builder<2>::addClamps();
+template void Builder<2>::addNodalClamp(SectionReader&, const std::string&, std::set<std::string>&);
+template void Builder<3>::addNodalClamp(SectionReader&, const std::string&, std::set<std::string>&);
 template std::string Builder<2>::readMotion(SectionReader&, Prescription<2>&);
 template std::string Builder<2>::motionText(const Prescription<2>&);
 template void Builder<2>::readPrescriptions();

@@ -26,33 +26,82 @@ void Builder<D>::readLoads() {
     const std::string regionName = r.has("region") ? config_.get("load." + name, "region") : "";
     load.particles = region(r);
     std::string where = regionName.empty() ? "" : " of region '" + regionName + "'";
-    if (r.has("face")) {
+    // A mesh body's named surface: its particles, each with its share of the true area.
+    const SurfacePatch<D>* surface = nullptr;
+    std::string faceName;
+    if (r.has("surface")) {
+      if (r.has("face")) throw r.error("face", "give either face or surface, not both");
+      if (!regionName.empty())
+        throw r.error("region",
+                      "a load on a named surface acts on the whole surface; give "
+                      "either region or surface");
+      const std::string surfaceName = config_.get("load." + name, "surface");
+      surface = &namedSurface(r);
+      load.particles = surface->particles;
+      where = " on surface " + surfaceName;
+    } else if (r.has("face")) {
       // The surface layer of the bodies' face (as for clamps), within the region if given.
-      const std::string face = r.word("face", std::nullopt, faceNames());
+      faceName = r.word("face", std::nullopt, faceNames());
       std::vector<Index> onFace;
       for (Index i : load.particles)
-        if (onBoundingFace(i, face)) onFace.push_back(i);
+        if (onBoundingFace(i, faceName)) onFace.push_back(i);
       if (onFace.empty())
         throw r.error("face", "the region '" + (regionName.empty() ? "all" : regionName) +
-                                  "' has no particle on face " + face +
-                                  " (the layer of particles at the bodies' extreme along " + face +
-                                  ")");
+                                  "' has no particle on face " + faceName +
+                                  " (the layer of particles at the bodies' extreme along " +
+                                  faceName + ")");
       load.particles = std::move(onFace);
-      where = " on face " + face + where;
+      where = " on face " + faceName + where;
     }
-    const std::string type = r.word("type", std::nullopt, {"traction", "force"});
-    const Vec<D> value = r.vector<D>("value");
+    const std::string type = r.word("type", std::nullopt, {"traction", "force", "pressure"});
+    Vec<D> value = Vec<D>::Zero();
+    double pressure = 0.0;
+    if (type == "pressure") {
+      pressure = r.number("value");
+      // Pressure pushes against the outward normal: it needs the surface's normals and areas,
+      // which a named surface has and a lattice face has exactly (dx^(d-1) per particle).
+      if (!surface && (faceName.empty() || setup_.freeForm))
+        throw r.error("type", setup_.freeForm
+                                  ? "pressure acts on a named surface (surface = NAME): a face "
+                                    "of a particle set has no known area"
+                                  : "pressure acts on a face of the bodies' bounding box (face "
+                                    "= x-, ...) or on a named surface of a mesh body");
+    } else {
+      value = r.vector<D>("value");
+    }
     load.ramp.duration = r.nonNegative("ramp", 0.0);
     r.finish();
-    if (type == "traction") warnInteriorTraction(load, regionName);
-    double volume = 0.0;
-    for (Index i : load.particles)
-      volume += p.volume[i];
-    for (Index i : load.particles) {
-      // (6.76): a traction acts on the area a_I = V_I^((d-1)/d) of each surface particle.
-      const double share =
-          type == "traction" ? std::pow(p.volume[i], (D - 1.0) / D) : p.volume[i] / volume;
-      load.force.push_back(share * value);
+    if (type == "traction" && !surface && !setup_.freeForm) warnInteriorTraction(load, regionName);
+    if (surface) {
+      // The surface's integrals: A_I = int lambda_I dA and a_I = int lambda_I n dA, so that the
+      // particles' forces add up to the load over the true area.
+      for (std::size_t k = 0; k < surface->particles.size(); ++k)
+        load.force.push_back(type == "pressure" ? Vec<D>(-pressure * surface->areaVector[k])
+                             : type == "traction"
+                                 ? Vec<D>(surface->area[k] * value)
+                                 : Vec<D>(surface->area[k] / surface->measure * value));
+    } else if (type == "pressure") {
+      // A lattice face: each surface particle carries dx^(d-1) of it.
+      Vec<D> outward = Vec<D>::Zero();
+      outward[faceName[0] - 'x'] = faceName[1] == '-' ? -1.0 : 1.0;
+      for (std::size_t k = 0; k < load.particles.size(); ++k)
+        load.force.push_back(-pressure * std::pow(setup_.dx, D - 1) * outward);
+    } else {
+      double volume = 0.0;
+      for (Index i : load.particles)
+        volume += p.volume[i];
+      for (Index i : load.particles) {
+        // (6.76): a traction acts on the area a_I = V_I^((d-1)/d) of each surface particle.
+        const double share =
+            type == "traction" ? std::pow(p.volume[i], (D - 1.0) / D) : p.volume[i] / volume;
+        load.force.push_back(share * value);
+      }
+    }
+    if (type == "pressure") {
+      setup_.conditions.push_back(load.name + ": pressure " + fmt(pressure) + " Pa on " +
+                                  std::to_string(load.particles.size()) + " particles" + where);
+      setup_.scene.loads.push_back(std::move(load));
+      continue;
     }
     setup_.conditions.push_back(load.name + ": " + type + " " + fmt<D>(value) + " on " +
                                 std::to_string(load.particles.size()) + " particles" + where);

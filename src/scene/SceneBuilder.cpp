@@ -67,6 +67,7 @@ template <int D>
 SceneSetup<D> buildScene(const Config& config) {
   SceneSetup<D> setup = scene_build::Builder<D>(config).build();
   const double dx = setup.dx;
+  if (!setup.coarsenable) return setup;
   setup.coarsen = [config, dx](int factor) -> std::unique_ptr<Scene<D>> {
     std::ostringstream spacing;
     spacing << std::setprecision(17) << factor * dx;

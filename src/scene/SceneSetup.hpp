@@ -9,6 +9,7 @@
 #include "explicit/Solver.hpp"
 #include "implicit/NewtonSolver.hpp"
 #include "model/Scene.hpp"
+#include "model/SurfacePatch.hpp"
 
 namespace tlsph {
 
@@ -83,6 +84,14 @@ struct SceneSetup {
   std::vector<std::uint8_t> body;          // per particle: index into bodyNames
   std::vector<std::uint8_t> ghost;         // per particle: 1 for clamp ghosts
   std::map<std::string, std::vector<Index>> regions;
+  // A mesh body's named surfaces (gmsh physical groups of dimension d - 1), by name.
+  std::map<std::string, SurfacePatch<D>> surfaces;
+  // Whether the body was read from a particle file or meshed from a CAD or mesh file rather
+  // than filled on the lattice (no ghost clamps, no lattice neighbours).
+  bool freeForm = false;
+  // Whether the scene can be rebuilt at a coarser dx (the Newton solver's multigrid levels): not
+  // a particle file, nor a mesh at a size of its own.
+  bool coarsenable = true;
   std::vector<std::string> conditions;  // one line per condition, for `tlsph check`
   std::vector<std::string> warnings;    // scene problems that do not stop a run
 };

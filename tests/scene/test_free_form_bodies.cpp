@@ -1,0 +1,226 @@
+// Bodies read from files: a particle set (CSV, VTU) is taken as it is, and one equal to a
+// lattice body's particles gives that body's run bit for bit; a body meshed by gmsh carries
+// its named surfaces, which clamps hold and loads act on over their true area.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <vtkDoubleArray.h>
+#include <vtkNew.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkUnstructuredGrid.h>
+#include <vtkXMLUnstructuredGridWriter.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <string>
+
+#include "explicit/Solver.hpp"
+#include "scene/Config.hpp"
+#include "scene/InputError.hpp"
+#include "scene/SceneBuilder.hpp"
+
+using namespace tlsph;
+namespace fs = std::filesystem;
+
+namespace {
+
+// A folder of its own for each test's files, removed afterwards.
+struct ScratchFolder {
+  fs::path path;
+  ScratchFolder() {
+    path = fs::temp_directory_path() /
+           ("tlsph-free-form-" + std::to_string(::getpid()) + "-" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(path);
+    fs::create_directories(path);
+  }
+  ~ScratchFolder() { fs::remove_all(path); }
+};
+
+const std::string kMaterial = R"(
+[material.rubber]
+model = neo-hookean
+density = 1000
+youngs_modulus = 1e6
+poisson_ratio = 0.3
+)";
+
+std::string sceneHead(int d, double dx) {
+  std::ostringstream s;
+  s << "[scene]\ndimension = " << d << "\ndx = " << dx << "\n[time]\nend = 1\n" << kMaterial;
+  return s.str();
+}
+
+// A free body that moves and deforms: gravity and a spin, no clamp.
+const std::string kDrive = R"(
+[gravity]
+acceleration = 0 -9.81 0
+[initial.spin]
+profile = rotation
+axis = 0 0 1
+point = 0 0 0
+rate = 3
+)";
+
+template <int D>
+std::string drive() {
+  if constexpr (D == 2)
+    return "[gravity]\nacceleration = 0 -9.81\n[initial.spin]\nprofile = "
+           "rotation\npoint = 0 0\nrate = 3\n";
+  return kDrive;
+}
+
+template <int D>
+SceneSetup<D> build(const std::string& text, const fs::path& scene) {
+  return buildScene<D>(Config::parse(text, scene.string()));
+}
+
+template <int D>
+void writeCsv(const fs::path& file, const ParticleSet<D>& p) {
+  std::ofstream out(file);
+  out << "# particles of a lattice box\n" << (D == 2 ? "volume, x, y\n" : "x, y, z, volume\n");
+  out << std::setprecision(17);
+  for (Index i = 0; i < p.size(); ++i) {
+    const auto& X = p.referencePosition[i];
+    if constexpr (D == 2)
+      out << p.volume[i] << ", " << X[0] << ", " << X[1] << "\n";
+    else
+      out << X[0] << ", " << X[1] << ", " << X[2] << ", " << p.volume[i] << "\n";
+  }
+}
+
+template <int D>
+void writeVtu(const fs::path& file, const ParticleSet<D>& p) {
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  vtkNew<vtkDoubleArray> volume;
+  volume->SetName("volume");
+  for (Index i = 0; i < p.size(); ++i) {
+    const auto& X = p.referencePosition[i];
+    points->InsertNextPoint(X[0], X[1], D == 3 ? X[D - 1] : 0.0);
+    volume->InsertNextValue(p.volume[i]);
+  }
+  vtkNew<vtkUnstructuredGrid> grid;
+  grid->SetPoints(points);
+  grid->GetPointData()->AddArray(volume);
+  vtkNew<vtkXMLUnstructuredGridWriter> writer;
+  writer->SetFileName(file.c_str());
+  writer->SetInputData(grid);
+  ASSERT_EQ(writer->Write(), 1);
+}
+
+// The box's own run and the run of its particles read back from a file, step by step.
+template <int D>
+void expectSameRun(const std::string& extension) {
+  ScratchFolder dir;
+  const std::string box = D == 2 ? "[body.block]\nshape = box\nlower = 0 0\nupper = 0.1 0.04\n"
+                                 : "[body.block]\nshape = box\nlower = 0 0 0\nupper = 0.1 0.04 "
+                                   "0.03\n";
+  const double dx = 0.01;
+  SceneSetup<D> lattice = build<D>(sceneHead(D, dx) + box + drive<D>(), dir.path / "box.ini");
+  const fs::path file = dir.path / ("block" + extension);
+  if (extension == ".csv")
+    writeCsv<D>(file, lattice.scene.particles);
+  else
+    writeVtu<D>(file, lattice.scene.particles);
+  SceneSetup<D> read = build<D>(sceneHead(D, dx) + "[body.block]\nshape = particles\nfile = block" +
+                                    extension + "\n" + drive<D>(),
+                                dir.path / "read.ini");
+  ASSERT_TRUE(read.freeForm);
+  ASSERT_EQ(read.scene.particles.size(), lattice.scene.particles.size());
+  for (Index i = 0; i < read.scene.particles.size(); ++i) {
+    ASSERT_EQ(read.scene.particles.referencePosition[i],
+              lattice.scene.particles.referencePosition[i]);
+    ASSERT_EQ(read.scene.particles.velocity[i], lattice.scene.particles.velocity[i]);
+  }
+  Solver<D> a(lattice.scene, lattice.solver), b(read.scene, read.solver);
+  EXPECT_EQ(a.timeStep(), b.timeStep());
+  for (int k = 0; k < 40; ++k) {
+    a.step();
+    b.step();
+  }
+  double moved = 0.0;
+  for (Index i = 0; i < read.scene.particles.size(); ++i) {
+    ASSERT_EQ(read.scene.particles.displacement[i], lattice.scene.particles.displacement[i]) << i;
+    moved = std::max(moved, lattice.scene.particles.displacement[i].norm());
+  }
+  EXPECT_GT(moved, 1e-4);  // the runs did move the body
+}
+
+}  // namespace
+
+TEST(ParticleFile, CsvOfALatticeBoxRunsAsTheBoxBitForBit2D) {
+  expectSameRun<2>(".csv");
+}
+TEST(ParticleFile, CsvOfALatticeBoxRunsAsTheBoxBitForBit3D) {
+  expectSameRun<3>(".csv");
+}
+TEST(ParticleFile, VtuOfALatticeBoxRunsAsTheBoxBitForBit2D) {
+  expectSameRun<2>(".vtu");
+}
+TEST(ParticleFile, VtuOfALatticeBoxRunsAsTheBoxBitForBit3D) {
+  expectSameRun<3>(".vtu");
+}
+
+TEST(ParticleFile, ErrorsNameTheFileTheLineAndTheProblem) {
+  ScratchFolder dir;
+  auto message = [&](const std::string& csv, const std::string& extra = "") {
+    std::ofstream(dir.path / "set.csv") << csv;
+    try {
+      build<2>(sceneHead(2, 0.01) + "[body.b]\nshape = particles\nfile = set.csv\n" + extra,
+               dir.path / "s.ini");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(message("x, y\n0 ,0\n").find("set.csv:1: the header has no column 'volume'"),
+            std::string::npos)
+      << message("x, y\n0 ,0\n");
+  EXPECT_NE(message("x,y,volume\n0,0,1e-4\n1,2\n")
+                .find("set.csv:3: 2 values, but the header "
+                      "names 3 columns"),
+            std::string::npos);
+  EXPECT_NE(message("x,y,volume\n0,0,-1e-4\n").find("set.csv:2: volume = -1e-4"),
+            std::string::npos);
+  EXPECT_NE(message("x,y,volume\n0,0,1e-4\n0,nan,1e-4\n").find("y = 'nan' is not a finite"),
+            std::string::npos);
+  EXPECT_NE(message("x,y,volume\n0,0,1e-4\n0.5,0,1e-4\n0,0,1e-4\n")
+                .find("line 4 repeats the position of line 2"),
+            std::string::npos);
+  EXPECT_NE(message("x,y,volume\n").find("holds no particle"), std::string::npos);
+  // The message starts at the scene's key.
+  EXPECT_NE(message("x,y,volume\n").find("s.ini:"), std::string::npos);
+  EXPECT_NE(message("x,y,volume\n").find("[body.b] file: "), std::string::npos);
+  // A particle body is the scene's only body, without holes.
+  EXPECT_NE(message("x,y,volume\n0,0,1e-4\n", "[body.c]\nshape = box\nlower = 0 0\nupper = 1 1\n")
+                .find("must be the scene's only body"),
+            std::string::npos);
+  EXPECT_NE(message("x,y,volume\n0,0,1e-4\n", "[hole.h]\nshape = ball\ncentre = 0 0\nradius = 1\n")
+                .find("cut the hole in the CAD model"),
+            std::string::npos);
+  // Mirrored clamps need the lattice.
+  EXPECT_NE(message("x,y,volume\n0,0,1e-4\n1,0,1e-4\n", "[clamp.c]\nface = x-\nmethod = mirror\n")
+                .find("method = nodal"),
+            std::string::npos);
+}
+
+TEST(ParticleFile, AClampOnAFaceHoldsTheParticlesThere) {
+  ScratchFolder dir;
+  std::ofstream(dir.path / "set.csv") << "x,y,volume\n0,0,1\n0,1,1\n1,0,1\n1,1,1\n2,0.5,1\n";
+  const auto setup = build<2>(sceneHead(2, 1.0) +
+                                  "[body.b]\nshape = particles\nfile = set.csv\n[clamp.c]\nface "
+                                  "= x-\n",
+                              dir.path / "s.ini");
+  ASSERT_EQ(setup.scene.prescriptions.size(), 1u);
+  const auto& held = setup.scene.prescriptions[0].particles;
+  ASSERT_EQ(held.size(), 2u);
+  for (Index i : held) {
+    EXPECT_EQ(setup.scene.particles.referencePosition[i].x(), 0.0);
+    EXPECT_EQ(setup.scene.particles.motion[i], Motion::Prescribed);
+  }
+  EXPECT_FALSE(setup.coarsen);  // a particle file cannot be rebuilt at a coarser dx
+}
