@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <numbers>
 #include <string>
 
 #include "explicit/Solver.hpp"
@@ -223,4 +224,127 @@ TEST(ParticleFile, AClampOnAFaceHoldsTheParticlesThere) {
     EXPECT_EQ(setup.scene.particles.motion[i], Motion::Prescribed);
   }
   EXPECT_FALSE(setup.coarsen);  // a particle file cannot be rebuilt at a coarser dx
+}
+
+namespace {
+
+const std::string kGeometry = std::string(TLSPH_SOURCE_DIR) + "/tests/geometry/data/";
+
+template <int D>
+Vec<D> totalForce(const Load<D>& load) {
+  Vec<D> sum = Vec<D>::Zero();
+  for (const auto& f : load.force)
+    sum += f;
+  return sum;
+}
+
+}  // namespace
+
+// A pressure on a flat face adds up to p times its area along the inward normal; on the closed
+// bore its shares cancel; the magnitudes add up to the surface's area.
+TEST(MeshBody, PressureOnANamedSurfaceAddsUpToPTimesTheArea3D) {
+  ScratchFolder dir;
+  const double p = 2.5e5;
+  const auto setup = build<3>(sceneHead(3, 0.5) + "[body.b]\nshape = mesh\nfile = " + kGeometry +
+                                  "box_hole.geo\n[load.top]\nsurface = top\ntype = pressure\n"
+                                  "value = 2.5e5\n[load.bore]\nsurface = bore\ntype = pressure\n"
+                                  "value = 2.5e5\n",
+                              dir.path / "s.ini");
+  ASSERT_EQ(setup.scene.loads.size(), 2u);
+  const auto& top = setup.surfaces.at("top");
+  const Vec<3> onTop = totalForce(setup.scene.loads[0]);
+  EXPECT_NEAR(onTop.z(), -p * top.measure, 1e-12 * p * top.measure);
+  EXPECT_NEAR(onTop.head<2>().norm(), 0.0, 1e-12 * p * top.measure);
+  // The order-2 surface's area against the exact 4 x 4 - pi.
+  EXPECT_NEAR(top.measure, 16.0 - std::numbers::pi, 1e-3);
+  for (Index i : setup.scene.loads[0].particles)
+    EXPECT_EQ(setup.scene.particles.referencePosition[i].z(), 2.0);
+  const auto& bore = setup.surfaces.at("bore");
+  EXPECT_LT(totalForce(setup.scene.loads[1]).norm(), 1e-12 * p * bore.measure);
+  double magnitudes = 0.0, areas = 0.0;
+  for (std::size_t k = 0; k < bore.particles.size(); ++k) {
+    magnitudes += bore.areaVector[k].norm();
+    areas += bore.area[k];
+    // The bore's normal points into the hole, towards its axis.
+    const Vec<3> X = setup.scene.particles.referencePosition[bore.particles[k]];
+    EXPECT_LT(bore.areaVector[k].head<2>().dot((X - Vec<3>(2, 2, 0)).head<2>()), 0.0);
+  }
+  EXPECT_NEAR(areas, bore.measure, 1e-12 * bore.measure);
+  // |a_I| < A_I where the normal turns within a particle's share, by about (h/R)^2/12 for facets
+  // of length h on a radius R (h <= 0.5 here, R = 1).
+  EXPECT_LT(magnitudes, areas);
+  EXPECT_GT(magnitudes, (1.0 - 0.5 * 0.5 / 6.0) * areas);
+  EXPECT_NEAR(bore.measure, 2 * std::numbers::pi * 2.0, 1e-3 * bore.measure);
+}
+
+TEST(MeshBody, PressureOnANamedCurveAddsUpToPTimesTheLength2D) {
+  ScratchFolder dir;
+  const auto setup = build<2>(sceneHead(2, 0.25) + "[body.b]\nshape = mesh\nfile = " + kGeometry +
+                                  "ring.geo\n[load.in]\nsurface = bore\n"
+                                  "type = pressure\nvalue = 1e6\n",
+                              dir.path / "s.ini");
+  const auto& bore = setup.surfaces.at("bore");
+  EXPECT_LT(totalForce(setup.scene.loads[0]).norm(), 1e-12 * 1e6 * bore.measure);
+  double magnitudes = 0.0;
+  for (std::size_t k = 0; k < bore.particles.size(); ++k) {
+    const Vec<2> X = setup.scene.particles.referencePosition[bore.particles[k]];
+    EXPECT_NEAR(X.norm(), 1.0, 1e-12);
+    // On a circle the vector area points exactly along the radius, inwards.
+    EXPECT_NEAR(std::abs(bore.areaVector[k].normalized().dot(X)), 1.0, 1e-12);
+    EXPECT_LT(bore.areaVector[k].dot(X), 0.0);
+    // A pressure in the bore pushes its particles outwards.
+    EXPECT_GT(setup.scene.loads[0].force[k].dot(X), 0.0);
+    magnitudes += bore.areaVector[k].norm();
+  }
+  EXPECT_NEAR(bore.measure, 2 * std::numbers::pi, 1e-4);
+  EXPECT_LT(magnitudes, bore.measure);  // as in 3D, h <= 0.25 on R = 1
+  EXPECT_GT(magnitudes, (1.0 - 0.25 * 0.25 / 6.0) * bore.measure);
+}
+
+TEST(MeshBody, AClampOnANamedSurfaceHoldsItsParticles) {
+  ScratchFolder dir;
+  const auto setup = build<3>(sceneHead(3, 0.5) + "[body.b]\nshape = mesh\nfile = " + kGeometry +
+                                  "box_hole.geo\n[clamp.c]\nsurface = bottom\n",
+                              dir.path / "s.ini");
+  ASSERT_EQ(setup.scene.prescriptions.size(), 1u);
+  const auto& held = setup.scene.prescriptions[0].particles;
+  EXPECT_EQ(held, setup.surfaces.at("bottom").particles);
+  std::size_t atBottom = 0;
+  for (Index i = 0; i < setup.scene.particles.size(); ++i)
+    atBottom += setup.scene.particles.referencePosition[i].z() == 0.0;
+  EXPECT_EQ(held.size(), atBottom);
+  for (Index i : held)
+    EXPECT_EQ(setup.scene.particles.motion[i], Motion::Prescribed);
+  // The volumes add up to the solid's (4 x 4 - pi) x 2 on the order-2 geometry.
+  double volume = 0.0;
+  for (Index i = 0; i < setup.scene.particles.size(); ++i)
+    volume += setup.scene.particles.volume[i];
+  EXPECT_NEAR(volume, (16.0 - std::numbers::pi) * 2.0, 1e-3 * volume);
+}
+
+TEST(MeshBody, ErrorsNameTheSurfaceAndTheChoices) {
+  ScratchFolder dir;
+  auto message = [&](const std::string& text) {
+    try {
+      build<3>(sceneHead(3, 0.5) + text, dir.path / "s.ini");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  const std::string body = "[body.b]\nshape = mesh\nfile = " + kGeometry + "box_hole.geo\n";
+  const std::string unknown = message(body + "[clamp.c]\nsurface = side\n");
+  EXPECT_NE(unknown.find("[clamp.c] surface"), std::string::npos) << unknown;
+  EXPECT_NE(unknown.find("bore"), std::string::npos) << unknown;
+  EXPECT_NE(unknown.find("bottom"), std::string::npos) << unknown;
+  EXPECT_NE(message(body + "[load.l]\nsurface = top\nface = z+\ntype = pressure\nvalue = 1\n")
+                .find("not both"),
+            std::string::npos);
+  EXPECT_NE(message("[body.b]\nshape = box\nlower = 0 0 0\nupper = 1 1 1\n[clamp.c]\nsurface = "
+                    "top\n")
+                .find("surface"),
+            std::string::npos);
+  const std::string missing = message("[body.b]\nshape = mesh\nfile = nowhere.step\n");
+  EXPECT_NE(missing.find("[body.b] file"), std::string::npos) << missing;
+  EXPECT_NE(missing.find("nowhere.step"), std::string::npos) << missing;
 }
