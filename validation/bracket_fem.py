@@ -166,7 +166,7 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 sys.path.insert(0, str(HERE))
-from fem import FemError, ccx_path, ccx_version, read_frd_blocks  # noqa: E402
+from fem import FemError, _rel, ccx_path, ccx_version, read_frd_blocks  # noqa: E402
 
 GEO = ROOT / "examples" / "bracket.geo"
 DEFAULT_OUT = HERE / "fem" / "out" / "bracket"
@@ -624,14 +624,6 @@ def run_bracket(h_mm, run_dir, threads, max_seconds, max_rss_gb, factor=1.0,
         raise FemError(f"h = {h_mm} mm: reaction {rf} does not balance {want} N "
                        f"(relative {rf_rel:.2e})")
     return rec
-
-
-def _rel(path):
-    path = Path(path).resolve()
-    try:
-        return str(path.relative_to(ROOT))
-    except ValueError:
-        return str(path)
 
 
 QUANTITIES = ["ux_P", "uy_P", "uz_P", "ux_Q", "uy_Q", "uz_Q"]
