@@ -109,7 +109,8 @@ void expectMomentIdentities(const MeshedBody<D>& body, double tolerance) {
     const Mat<D> central = body.spread[i] - mu * mu.transpose();
     // positive definite: the leading principal minors (Sylvester)
     EXPECT_GT(central(0, 0), 0.0) << i;
-    EXPECT_GT(central.template topLeftCorner<2, 2>().determinant(), 0.0) << i;
+    const double minor2 = central.template topLeftCorner<2, 2>().determinant();
+    EXPECT_GT(minor2, 0.0) << i;
     EXPECT_GT(central.determinant(), 0.0) << i;
     worstOffset = std::max(worstOffset, mu.norm() / std::sqrt(body.spread[i].trace()));
   }
