@@ -56,8 +56,8 @@ class ForceEvaluator {
                                             Kernel<D>(scene_.kernel, scene_.supportRadius),
                                             scene_.periodicBox, scene_.gradientCorrection)),
         forces_(ref_, scene_.materials, scene_.particles.material, scene_.particles.volume,
-                scene_.hourglass(), scene_.quadrature, scene_.viscosity,
-                0.5 * scene_.supportRadius) {}
+                scene_.hourglass(), scene_.quadrature, scene_.viscosity, 0.5 * scene_.supportRadius,
+                {}, scene_.particles.quadratureMoments()) {}
   ForceEvaluator(const ForceEvaluator&) = delete;
   ForceEvaluator& operator=(const ForceEvaluator&) = delete;
 

@@ -18,6 +18,7 @@
 #include "explicit/Solver.hpp"
 #include "implicit/NewtonSolver.hpp"
 #include "io/CheckpointArchive.hpp"
+#include "model/QuadratureMoments.hpp"
 #include "output/PvdFile.hpp"
 
 namespace tlsph {
@@ -43,15 +44,24 @@ struct CheckpointOrigin {
   std::string particles;
 };
 
-// "N particles, FNV-1a <hex>" over the bytes of the reference positions in their order.
+// "N particles, FNV-1a <hex>" over the bytes of the reference positions in their order, then
+// of the particles' quadrature moments when they have their own (a meshed body: a tlsph that
+// integrates them otherwise would continue the run with another energy); lattice cells add
+// nothing.
 template <int D>
-std::string particleDigest(const std::vector<Vec<D>>& X) {
+std::string particleDigest(const std::vector<Vec<D>>& X, const QuadratureMoments<D>& moments = {}) {
   std::uint64_t h = 14695981039346656037ull;
-  for (const auto& x : X) {
-    const auto* b = reinterpret_cast<const unsigned char*>(x.data());
-    for (std::size_t k = 0; k < sizeof(double) * D; ++k)
+  auto add = [&h](const double* data, std::size_t count) {
+    const auto* b = reinterpret_cast<const unsigned char*>(data);
+    for (std::size_t k = 0; k < sizeof(double) * count; ++k)
       h = (h ^ b[k]) * 1099511628211ull;
-  }
+  };
+  for (const auto& x : X)
+    add(x.data(), D);
+  for (const auto& mu : moments.offset)
+    add(mu.data(), D);
+  for (const auto& N : moments.spread)
+    add(N.data(), D * D);
   char hex[17];
   std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
   return std::to_string(X.size()) + " particles, FNV-1a " + hex;

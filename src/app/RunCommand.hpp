@@ -89,7 +89,8 @@ int runOrCheck(const Config& config, bool run, bool progress, const std::string&
   options.progress = progress;
   options.command = command;
   options.origin = runOrigin(config, flags, threads);
-  options.origin.particles = particleDigest<D>(setup.scene.particles.referencePosition);
+  options.origin.particles = particleDigest<D>(setup.scene.particles.referencePosition,
+                                               setup.scene.particles.quadratureMoments());
   options.comm = comm;
 
   std::optional<Checkpoint<D>> resume;

@@ -55,7 +55,7 @@ class Solver {
         ref_(buildPairData(scene, checkedKernel(scene), plan_, comm)),
         forces_(ref_, scene.materials, scene.particles.material, scene.particles.volume,
                 scene.hourglass(), scene.quadrature, scene.viscosity, 0.5 * scene.supportRadius,
-                MirroredGhosts<D>::checkedGhostList(scene)) {
+                MirroredGhosts<D>::checkedGhostList(scene), scene.particles.quadratureMoments()) {
     if (!(settings.cfl > 0.0)) throw SetupError("the CFL number must be positive");
     const auto& p = scene.particles;
     if (plan_.active) {

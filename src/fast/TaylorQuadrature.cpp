@@ -9,6 +9,8 @@
 #endif
 #include "fast/TaylorQuadrature.hpp"
 
+#include "model/Errors.hpp"
+
 namespace tlsph {
 
 template <int D>
@@ -16,7 +18,8 @@ TaylorQuadrature<D>::TaylorQuadrature(const ReferenceConfiguration<D>& ref,
                                       const std::vector<Material>& materials,
                                       const std::vector<std::uint16_t>& materialOf,
                                       const std::vector<double>& volume,
-                                      const std::vector<std::uint8_t>& passive)
+                                      const std::vector<std::uint8_t>& passive,
+                                      const QuadratureMoments<D>& moments)
     : ref_(ref), volume_(volume) {
   const auto& nb = ref.neighbours;
   const Index n = ref.particleCount();
@@ -30,6 +33,13 @@ TaylorQuadrature<D>::TaylorQuadrature(const ReferenceConfiguration<D>& ref,
   lambda_.assign(n, 0.0);
   mu_.assign(n, 0.0);
   smallStrain_.assign(n, 0);
+  general_ = !moments.lattice();
+  if (general_) {
+    if (moments.offset.size() != std::size_t(n) || moments.spread.size() != std::size_t(n))
+      throw SetupError("the particles' quadrature moments are not one per particle");
+    offset_.assign(n, Vec<D>::Zero());
+    spread_.assign(n, Mat<D>::Zero());
+  }
   std::vector<std::uint8_t> fallback(n, 0);
   for (Index i : ref.linearFallback)
     fallback[i] = 1;
@@ -41,7 +51,11 @@ TaylorQuadrature<D>::TaylorQuadrature(const ReferenceConfiguration<D>& ref,
     if (energy) {
       const auto& c = elasticConstants(materials[materialOf[i]]);
       const double l = std::pow(volume[i], 1.0 / D);
-      weight_[i] = l * l / 12.0;
+      weight_[i] = l * l / 12.0;  // with general moments only a mark that the term is on
+      if (general_) {
+        offset_[i] = moments.offset[i];
+        spread_[i] = moments.spread[i];
+      }
       lambda_[i] = c.lambda;
       mu_[i] = c.mu;
       smallStrain_[i] = std::holds_alternative<LinearElastic>(materials[materialOf[i]]);

@@ -21,6 +21,11 @@
 //   through G_a = dF/dX_a: R_Ia = c_I F_I sigma_a,  f_I += V_I (R_I . Sum_I - sum_J R_J . T_IJ)
 // with (R . S) = sum_ab R_a(:, b) S(b, a), Sum_I = sum_J S_IJ and T_IJ = (V_J / V_I) S_JI
 // (S_IJ symmetric: stored as its D(D+1)/2 entries, R likewise, see symmetric()).
+// With the moments of each particle's weight (model/QuadratureMoments.hpp: the nodes of a
+// meshed body), the term is the general one of method/TaylorCorrection.hpp,
+//   E_q = sum_I V_I [1/2 sum_ab N_ab e_a : C0 : e_b + sum_a mu_a (C0 : E) : e_a],
+// evaluated unfused per particle (generalStress); lattice scenes, mu = 0 and N = c_I 1, run the
+// fused code above, one branch per particle on a flag of the scene.
 // Only with the quadratic correction; particles on the linear fallback and passive particles
 // (mirrored ghosts) carry no correction.
 #pragma once
@@ -40,6 +45,7 @@
 #include "fast/SharedRows.hpp"
 #include "materials/Material.hpp"
 #include "method/ReferenceConfiguration.hpp"
+#include "model/QuadratureMoments.hpp"
 #include "model/Types.hpp"
 
 namespace tlsph {
@@ -58,10 +64,12 @@ class TaylorQuadrature {
   // one record, so that the F pass reads one stream and multiplies it as one row (gradients()).
   using Fit = Eigen::Matrix<double, 1, D + P>;
 
-  // Builds the second-derivative vectors S_IJ from the quadratic fit (TaylorQuadrature.cpp).
+  // Builds the second-derivative vectors S_IJ from the quadratic fit (TaylorQuadrature.cpp);
+  // moments: the particles' quadrature moments (empty: lattice cells).
   TaylorQuadrature(const ReferenceConfiguration<D>& ref, const std::vector<Material>& materials,
                    const std::vector<std::uint16_t>& materialOf, const std::vector<double>& volume,
-                   const std::vector<std::uint8_t>& passive);
+                   const std::vector<std::uint8_t>& passive,
+                   const QuadratureMoments<D>& moments = {});
 
   // grad grad u at particle i: G_a(:, b) = d^2 u / dX_a dX_b.
   Gradients secondGradients(Index i, const std::vector<Vec<D>>& u) const {
@@ -119,6 +127,8 @@ class TaylorQuadrature {
   Mat<D> stressAt(Index i, const Mat<D>& F, const SymMatrix& Gs) requires(D == 2) {
     if (weight_[i] == 0.0) return Mat<D>::Zero();  // R_i stays zero
     G_[i] = Gs;
+    if (general_) [[unlikely]]
+      return generalStress(i, F, Gs);
     if (smallStrain_[i]) return smallStrainHyperstress(i, Gs).template topRows<D>();
     const Gradients A = unpack(F.transpose() * Gs);  // F^T G_a
     const Gradients G = unpack(Gs);
@@ -168,6 +178,12 @@ class TaylorQuadrature {
       }
       const Gradients dG = secondGradients(i, v);
       const Gradients G = unpack(Gs[i]);
+      if (general_) {
+        const auto d = generalLinearised(i, F[i], G, dH[i], dG);
+        R_[i].template topRows<D>() = symmetric(d.hyperstress);
+        dstress[i] += d.stress;
+        continue;
+      }
       // small strain: F -> 1, dH -> 0, and no P^q
       const bool small = smallStrain_[i];
       const Mat<D> Fi = small ? Mat<D>::Identity() : F[i];
@@ -219,6 +235,7 @@ class TaylorQuadrature {
   double energy(std::span<const Mat<D>> F) const {
     return orderedSum(ref_.particleCount(), [&](Index i) {
       if (weight_[i] == 0.0) return 0.0;
+      if (general_) return generalEnergy(i, F[i], unpack(G_[i]));
       double e = 0.0;
       const Gradients G = unpack(G_[i]);
       for (int a = 0; a < D; ++a) {
@@ -314,6 +331,10 @@ class TaylorQuadrature {
     }
     const auto Gp = M.template rightCols<P>();  // Gs padded
     const auto Gs = Gp.template topRows<D>();
+    if (general_) [[unlikely]] {
+      addTop<D>(padded<D, D>(generalStress(i, F.template topRows<D>(), Gs)), Pm, stress);
+      return;
+    }
     if (smallStrain_[i]) {
       smallStrainHyperstress(i, Gs);
       addTop<D>(Pq, Pm, stress);
@@ -415,6 +436,90 @@ class TaylorQuadrature {
     return a <= b ? a * D - a * (a - 1) / 2 + (b - a) : sym(b, a);
   }
 
+  // The general term (method/TaylorCorrection.hpp) of particle i from its F and G_a:
+  // C0 : e_a, C0 : E (E = 1/2 (F^T F - 1), or sym(F - 1) for the linear-elastic material), and
+  // sigma_a = sum_b N_ab C0 : e_b + mu_a C0 : E, tau = sum_a mu_a C0 : e_a.
+  struct GeneralStresses {
+    Gradients s, sigma;  // C0 : e_a, sigma_a
+    Mat<D> S, tau;       // C0 : E, tau
+  };
+  GeneralStresses generalStresses(Index i, const Mat<D>& F, const Gradients& G) const {
+    const bool small = smallStrain_[i];
+    GeneralStresses t;
+    for (int a = 0; a < D; ++a)
+      t.s[a] = stressOf(i, small ? G[a] : Mat<D>(F.transpose() * G[a]));
+    const Mat<D> I = Mat<D>::Identity();
+    t.S = stressOf(i, small ? Mat<D>(F - I) : Mat<D>(0.5 * (F.transpose() * F - I)));
+    t.tau.setZero();
+    for (int a = 0; a < D; ++a) {
+      t.sigma[a] = offset_[i][a] * t.S;
+      for (int b = 0; b < D; ++b)
+        t.sigma[a] += spread_[i](a, b) * t.s[b];
+      t.tau += offset_[i][a] * t.s[a];
+    }
+    return t;
+  }
+  // P^q = sum_a G_a sigma_a + F tau (tau for the linear-elastic material), keeping the
+  // hyperstress R_a = F sigma_a (sigma_a). Not inlined: the lattice pass around its call stays
+  // as it was.
+  [[gnu::noinline]] Mat<D> generalStress(Index i, const Mat<D>& F, const SymMatrix& Gs) {
+    const Gradients G = unpack(Gs);
+    const GeneralStresses t = generalStresses(i, F, G);
+    const bool small = smallStrain_[i];
+    Gradients R;
+    Mat<D> Pq = small ? t.tau : Mat<D>(F * t.tau);
+    for (int a = 0; a < D; ++a) {
+      if (!small) Pq += G[a] * t.sigma[a];
+      R[a] = small ? t.sigma[a] : Mat<D>(F * t.sigma[a]);
+    }
+    R_[i].template topRows<D>() = symmetric(R);
+    return Pq;
+  }
+  // V_I [1/2 sum_ab N_ab e_a : C0 : e_b + sum_a mu_a (C0 : E) : e_a]
+  double generalEnergy(Index i, const Mat<D>& F, const Gradients& G) const {
+    const GeneralStresses t = generalStresses(i, F, G);
+    double e = 0.0;
+    for (int a = 0; a < D; ++a) {
+      const Mat<D> A = smallStrain_[i] ? G[a] : Mat<D>(F.transpose() * G[a]);
+      const Mat<D> ea = 0.5 * (A + A.transpose());
+      for (int b = 0; b < D; ++b)
+        e += 0.5 * spread_[i](a, b) * (t.s[b].array() * ea.array()).sum();
+      e += offset_[i][a] * (t.S.array() * ea.array()).sum();
+    }
+    return volume_[i] * e;
+  }
+  // dP^q and dR_a (method/TaylorCorrection::linearised).
+  struct GeneralLinearised {
+    Mat<D> stress;
+    Gradients hyperstress;
+  };
+  GeneralLinearised generalLinearised(Index i, const Mat<D>& F, const Gradients& G,
+                                      const Mat<D>& dH, const Gradients& dG) const {
+    const bool small = smallStrain_[i];
+    const GeneralStresses t = generalStresses(i, F, G);
+    Gradients ds;  // C0 : de_a
+    for (int a = 0; a < D; ++a)
+      ds[a] = stressOf(i, small ? dG[a] : Mat<D>(dH.transpose() * G[a] + F.transpose() * dG[a]));
+    const Mat<D> dS = stressOf(i, small ? dH : Mat<D>(F.transpose() * dH));  // C0 : dE
+    Mat<D> dtau = Mat<D>::Zero();
+    for (int a = 0; a < D; ++a)
+      dtau += offset_[i][a] * ds[a];
+    GeneralLinearised d;
+    d.stress = small ? dtau : Mat<D>(dH * t.tau + F * dtau);
+    for (int a = 0; a < D; ++a) {
+      Mat<D> dsigma = offset_[i][a] * dS;
+      for (int b = 0; b < D; ++b)
+        dsigma += spread_[i](a, b) * ds[b];
+      if (small) {
+        d.hyperstress[a] = dsigma;
+      } else {
+        d.stress += dG[a] * t.sigma[a] + G[a] * dsigma;
+        d.hyperstress[a] = dH * t.sigma[a] + F * dsigma;
+      }
+    }
+    return d;
+  }
+
   // The linear-elastic material's hyperstress, e_a = sym(G_a): no P^q.
   PaddedMat<D> smallStrainHyperstress(Index i, const SymMatrix& Gs) {
     const Gradients G = unpack(Gs);
@@ -462,6 +567,9 @@ class TaylorQuadrature {
   std::vector<Sym> sum_;     // sum_J S_IJ
   std::vector<double> weight_, lambda_, mu_;
   std::vector<std::uint8_t> smallStrain_;  // linear-elastic material: e_a = sym(G_a)
+  bool general_ = false;                   // the particles' own moments, not lattice cells'
+  std::vector<Vec<D>> offset_;             // mu_I (only when general_)
+  std::vector<Mat<D>> spread_;             // N_I (only when general_)
   std::vector<SymMatrix> G_;               // grad grad u, symmetric storage
   LargeArray<PaddedSymMatrix> R_;          // hyperstress, symmetric storage, padded (gathered)
   std::vector<Vec<D>> force_;

@@ -54,7 +54,8 @@ class TlsphForces {
               const std::vector<std::uint16_t>& materialOfParticle,
               const std::vector<double>& volume, const HourglassSettings& hourglass,
               Quadrature quadrature = Quadrature::Nodal, const ViscositySettings& viscosity = {},
-              double smoothingLength = 0.0, const std::vector<Index>& passive = {})
+              double smoothingLength = 0.0, const std::vector<Index>& passive = {},
+              const QuadratureMoments<D>& moments = {})
       : ref_(reference),
         materials_(materials),
         volume_(volume),
@@ -80,7 +81,7 @@ class TlsphForces {
     passive_ = passive;
     if (quadrature == Quadrature::Taylor) {
       quadrature_ = std::make_unique<TaylorQuadrature<D>>(reference, materials, materialOfParticle,
-                                                          volume, isPassive);
+                                                          volume, isPassive, moments);
     } else {
       P_.assign(n, Mat<D>::Zero());  // (with Taylor, P is only a part of P + P^q)
     }

@@ -248,15 +248,21 @@ class NodeTable {
 };
 
 // One element type's integration data: quadrature points, weights, the Lagrange gradients of
-// all its nodes and the hats of its corners at those points.
+// all its nodes and the hats of its corners at those points (and, for the moments, the
+// Lagrange values of all its nodes: the point's position).
 struct ElementRule {
   int dim = 0, order = 0, nodes = 0, corners = 0;
   std::string name;
   std::vector<double> weight;
-  std::vector<double> grad;  // [point][node][3]
-  std::vector<double> hat;   // [point][corner]
+  std::vector<double> grad;   // [point][node][3]
+  std::vector<double> hat;    // [point][corner]
+  std::vector<double> value;  // [point][node], moments only
   std::size_t points() const { return weight.size(); }
 };
+
+// What a rule integrates: a D-element's volume (hat times det J), its moments (the same times
+// a quadratic in x, of degree 2 order in the reference coordinates), or a facet's area.
+enum class RuleUse { Volume, Moments, Facet };
 
 std::string familyName(int dim, int corners) {
   if (dim == 1 && corners == 2) return "Line";
@@ -274,7 +280,8 @@ std::string familyName(int dim, int corners) {
 // dim * order), and of degree 2 order + 4 on facets, whose area element (a square root on curved
 // facets) is not a polynomial. gmsh's "GaussN" rules with a negative weight (4.8: tetrahedra 4,
 // 7, 8, 10; triangles 7) are skipped for the next one.
-ElementRule makeRule(int type, bool facet) {
+ElementRule makeRule(int type, RuleUse use) {
+  const bool facet = use == RuleUse::Facet;
   ElementRule rule;
   std::vector<double> local;
   gmsh::model::mesh::getElementProperties(type, rule.name, rule.dim, rule.order, rule.nodes, local,
@@ -288,6 +295,7 @@ ElementRule makeRule(int type, bool facet) {
     degree = rule.dim * (rule.order - 1) + 1;
   else
     degree = rule.dim * rule.order + 1;
+  if (use == RuleUse::Moments) degree += 2 * rule.order;
   degree = std::max(degree, 4);  // gmsh's tensor rules below Gauss4 are not Gauss products
   std::vector<double> points;
   for (;; ++degree) {
@@ -302,20 +310,23 @@ ElementRule makeRule(int type, bool facet) {
   const int linear = gmsh::model::mesh::getElementType(family, 1);
   gmsh::model::mesh::getBasisFunctions(linear, points, "Lagrange", components, rule.hat,
                                        orientations);
+  if (use == RuleUse::Moments)
+    gmsh::model::mesh::getBasisFunctions(type, points, "Lagrange", components, rule.value,
+                                         orientations);
   return rule;
 }
 
 class RuleCache {
  public:
-  const ElementRule& operator()(int type, bool facet) {
-    const auto key = std::make_pair(type, facet);
+  const ElementRule& operator()(int type, RuleUse use) {
+    const auto key = std::make_pair(type, use);
     auto it = rules_.find(key);
-    if (it == rules_.end()) it = rules_.emplace(key, makeRule(type, facet)).first;
+    if (it == rules_.end()) it = rules_.emplace(key, makeRule(type, use)).first;
     return it->second;
   }
 
  private:
-  std::map<std::pair<int, bool>, ElementRule> rules_;
+  std::map<std::pair<int, RuleUse>, ElementRule> rules_;
 };
 
 // The Jacobian columns dx/du_k at one quadrature point of an element with nodes x.
@@ -563,9 +574,9 @@ MeshedBody<D> meshBody(const std::string& path, double size, const MeshOptions& 
   });
 
   RuleCache rules;
-  auto rule = [&](int type, bool facet) -> const ElementRule& {
+  auto rule = [&](int type, RuleUse use) -> const ElementRule& {
     const ElementRule* r = nullptr;
-    session.run("reading the element basis", [&] { r = &rules(type, facet); });
+    session.run("reading the element basis", [&] { r = &rules(type, use); });
     return *r;
   };
 
@@ -575,7 +586,7 @@ MeshedBody<D> meshBody(const std::string& path, double size, const MeshOptions& 
   int maxOrder = 0;
   for (const auto& entityBlocks : blocks)
     for (const auto& block : entityBlocks) {
-      const ElementRule& r = rule(block.type, false);
+      const ElementRule& r = rule(block.type, RuleUse::Volume);
       maxOrder = std::max(maxOrder, r.order);
       const std::size_t n = block.nodes.size() / r.nodes;
       elementCount += n;
@@ -607,13 +618,23 @@ MeshedBody<D> meshBody(const std::string& path, double size, const MeshOptions& 
   const double planeTolerance = 1e-9 * std::max(extent, 1e-300);
   std::vector<Vec3> x;
   std::vector<std::pair<Index, double>> contribution;  // one entity's (particle, signed volume)
+  // and its signed moments int lambda_I (x - X_I) dV, int lambda_I (x - X_I)(x - X_I)^T dV
+  std::vector<std::pair<Vec<D>, Mat<D>>> momentContribution;
   std::vector<double> elementSigned;
+  std::vector<Vec<D>> m1(body.position.size(), Vec<D>::Zero());
+  std::vector<Mat<D>> M2(body.position.size(), Mat<D>::Zero());
+  body.firstMoment.setZero();
+  body.secondMoment.setZero();
   for (std::size_t k = 0; k < entities.size(); ++k) {
     contribution.clear();
+    momentContribution.clear();
     elementSigned.clear();
     double entitySigned = 0;
+    Vec<D> entityFirst = Vec<D>::Zero();
+    Mat<D> entitySecond = Mat<D>::Zero();
     for (const auto& block : blocks[k]) {
-      const ElementRule& r = rule(block.type, false);
+      const ElementRule& r = rule(block.type, RuleUse::Volume);
+      const ElementRule& rm = rule(block.type, RuleUse::Moments);
       const std::size_t n = block.nodes.size() / r.nodes;
       for (std::size_t e = 0; e < n; ++e) {
         const std::size_t* tags = &block.nodes[e * r.nodes];
@@ -640,6 +661,25 @@ MeshedBody<D> meshBody(const std::string& path, double size, const MeshOptions& 
           for (int a = 0; a < r.corners; ++a)
             contribution[first + a].second += r.hat[q * r.corners + a] * dv;
         }
+        // The moments, on the same geometry with a rule of 2 order degrees more.
+        momentContribution.resize(contribution.size(), {Vec<D>::Zero(), Mat<D>::Zero()});
+        for (std::size_t q = 0; q < rm.points(); ++q) {
+          Vec3 c[3];
+          jacobian(rm, q, x, c);
+          const double dv = signedDensity<D>(c) * rm.weight[q];
+          Vec3 xq = Vec3::Zero();
+          for (int a = 0; a < rm.nodes; ++a)
+            xq += rm.value[q * rm.nodes + a] * x[a];
+          const Vec<D> X = head<D>(xq);
+          entityFirst += dv * X;
+          entitySecond += dv * X * X.transpose();
+          for (int a = 0; a < rm.corners; ++a) {
+            const Vec<D> d = X - body.position[contribution[first + a].first];
+            const double w = rm.hat[q * rm.corners + a] * dv;
+            momentContribution[first + a].first += w * d;
+            momentContribution[first + a].second += w * d * d.transpose();
+          }
+        }
         elementSigned.push_back(total);
         entitySigned += total;
       }
@@ -650,15 +690,27 @@ MeshedBody<D> meshBody(const std::string& path, double size, const MeshOptions& 
         throw GeometryError(path + ": an inverted element (volume " + numberText(sign * v) +
                             " against its neighbours' orientation) in " +
                             (D == 3 ? "volume " : "surface ") + std::to_string(entities[k].second));
-    for (const auto& [p, v] : contribution)
-      body.volume[p] += sign * v;
+    for (std::size_t c = 0; c < contribution.size(); ++c) {
+      const Index p = contribution[c].first;
+      body.volume[p] += sign * contribution[c].second;
+      m1[p] += sign * momentContribution[c].first;
+      M2[p] += sign * momentContribution[c].second;
+    }
     body.measure += sign * entitySigned;
+    body.firstMoment += sign * entityFirst;
+    body.secondMoment += sign * entitySecond;
   }
   for (std::size_t i = 0; i < body.volume.size(); ++i)
     if (!(body.volume[i] > 0))
       throw GeometryError(path + ": non-positive volume " + numberText(body.volume[i]) +
                           " of the node at " + pointText<D>(body.position[i]) +
                           " (an inverted element there)");
+  body.offset.resize(body.position.size());
+  body.spread.resize(body.position.size());
+  for (std::size_t i = 0; i < body.volume.size(); ++i) {
+    body.offset[i] = m1[i] / body.volume[i];
+    body.spread[i] = M2[i] / body.volume[i];
+  }
 
   // Physical groups.
   gmsh::vectorpair groups;
@@ -683,7 +735,7 @@ MeshedBody<D> meshBody(const std::string& path, double size, const MeshOptions& 
       std::vector<Index>& list = body.volumes[name];
       for (const auto& entityBlocks : groupBlocks)
         for (const auto& block : entityBlocks) {
-          const ElementRule& r = rule(block.type, false);
+          const ElementRule& r = rule(block.type, RuleUse::Volume);
           for (std::size_t e = 0; e < block.nodes.size() / r.nodes; ++e)
             for (int a = 0; a < r.corners; ++a)
               list.push_back(particleOf.at(block.nodes[e * r.nodes + a]));
@@ -704,7 +756,7 @@ MeshedBody<D> meshBody(const std::string& path, double size, const MeshOptions& 
     std::map<Index, Vec<D>> areaVectorOf;
     for (const auto& entityBlocks : groupBlocks)
       for (const auto& block : entityBlocks) {
-        const ElementRule& r = rule(block.type, true);
+        const ElementRule& r = rule(block.type, RuleUse::Facet);
         const std::size_t n = block.nodes.size() / r.nodes;
         for (std::size_t e = 0; e < n; ++e) {
           std::vector<Index> corner(r.corners);

@@ -72,9 +72,21 @@ struct MeshedBody {
   // reference element, dV from the order-2 geometry (first order for a first-order .msh). Every
   // V_I > 0 (GeometryError otherwise).
   std::vector<double> volume;
+  // The moments of each node's hat lambda_I about the node, divided by its volume
+  // (model/QuadratureMoments.hpp): offset mu_I = 1/V_I int lambda_I (x - X_I) dV and spread
+  // N_I = 1/V_I int lambda_I (x - X_I)(x - X_I)^T dV, on the same geometry as the volumes with a
+  // rule exact for them (2 order degrees above the volumes'). A node on the surface has its
+  // hat's centroid inside the body (mu_I != 0), and N_I is not a lattice cell's l^2/12 1: the
+  // Taylor quadrature term needs both to correct the one-point sum at the nodes.
+  std::vector<Vec<D>> offset;
+  std::vector<Mat<D>> spread;
   // The mesh's measure (volume; 2D: area) integrated element by element on the same geometry,
   // without the hats: sum of volume equals it by partition of unity (up to rounding).
   double measure = 0;
+  // Likewise int x dV and int x x^T dV: sum_I V_I (X_I + mu_I) equals the first, and
+  // sum_I V_I (X_I X_I^T + mu_I X_I^T + X_I mu_I^T + N_I) the second.
+  Vec<D> firstMoment = Vec<D>::Zero();
+  Mat<D> secondMoment = Mat<D>::Zero();
   // The CAD model's measure from OpenCASCADE (occ::getMass of its D-dimensional entities) when
   // the model has OpenCASCADE entities; NaN otherwise (built-in kernel .geo, .stl, .msh).
   double exactMeasure = std::numeric_limits<double>::quiet_NaN();

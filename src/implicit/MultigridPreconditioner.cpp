@@ -102,7 +102,7 @@ MultigridPreconditioner<D>::MultigridPreconditioner(const Scene<D>& fine, const 
     level->dofs = level->ownDofs.get();
     level->ownTangent = std::make_unique<TangentStiffness<D>>(
         level->solver->reference(), s.materials, s.particles.material, s.particles.volume,
-        s.hourglass(), *level->dofs, s.quadrature);
+        s.hourglass(), *level->dofs, s.quadrature, s.particles.quadratureMoments());
     level->tangent = level->ownTangent.get();
     if (level->dofs->size() == 0) throw SetupError("multigrid: a coarse level has no unknowns");
     const Kernel<D> kernel(s.kernel, s.supportRadius);

@@ -16,7 +16,8 @@ NewtonSolver<D>::NewtonSolver(Scene<D>& scene, Solver<D>& solver, const NewtonSe
       settings_(settings),
       dofs_(scene.particles, scene.mirrorGhosts),
       tangent_(solver.reference(), scene.materials, scene.particles.material,
-               scene.particles.volume, scene.hourglass(), dofs_, scene.quadrature) {
+               scene.particles.volume, scene.hourglass(), dofs_, scene.quadrature,
+               scene.particles.quadratureMoments()) {
   if (settings.loadSteps < 1) throw SetupError("[static] load_steps must be at least 1");
   const Index unknowns = D * dofs_.size();
   const bool explicitly = settings.preconditioner == NewtonPreconditioner::Multigrid;

@@ -52,7 +52,8 @@ class TangentStiffness {
   TangentStiffness(const ReferenceConfiguration<D>& ref, const std::vector<Material>& materials,
                    const std::vector<std::uint16_t>& materialOf, const std::vector<double>& volume,
                    const HourglassSettings& hourglass, const DofMap<D>& dofs,
-                   Quadrature quadrature = Quadrature::Nodal)
+                   Quadrature quadrature = Quadrature::Nodal,
+                   const QuadratureMoments<D>& moments = {})
       : ref_(ref),
         materials_(materials),
         volume_(volume),
@@ -90,8 +91,8 @@ class TangentStiffness {
       penaltyStress_.assign(n_, Mat<D>::Zero());
     }
     if (quadrature == Quadrature::Taylor) {
-      quadrature_ =
-          std::make_unique<TaylorQuadrature<D>>(ref, materials, materialOf, volume, isPassive);
+      quadrature_ = std::make_unique<TaylorQuadrature<D>>(ref, materials, materialOf, volume,
+                                                          isPassive, moments);
       quadratureF_.assign(n_, Mat<D>::Identity());
       quadratureG_.assign(n_, TaylorQuadrature<D>::SymMatrix::Zero());
     }

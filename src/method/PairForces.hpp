@@ -31,12 +31,14 @@ namespace tlsph {
 template <int D>
 class PairForces {
  public:
-  // passive: particles with an F but no energy of their own (mirrored ghosts).
+  // passive: particles with an F but no energy of their own (mirrored ghosts); moments: the
+  // particles' quadrature moments for the Taylor term (empty: lattice cells).
   PairForces(const ReferenceConfiguration<D>& reference, const std::vector<Material>& materials,
              const std::vector<std::uint16_t>& materialOfParticle,
              const std::vector<double>& volume, const HourglassSettings& hourglass,
              Quadrature quadrature = Quadrature::Nodal, const ViscositySettings& viscosity = {},
-             double smoothingLength = 0.0, const std::vector<Index>& passive = {})
+             double smoothingLength = 0.0, const std::vector<Index>& passive = {},
+             const QuadratureMoments<D>& moments = {})
       : ref_(reference),
         materials_(materials),
         materialOf_(materialOfParticle),
@@ -48,8 +50,8 @@ class PairForces {
         passive_.at(i) = 1;
     }
     if (quadrature == Quadrature::Taylor)
-      taylor_ =
-          std::make_unique<TaylorCorrection<D>>(ref_, materials_, materialOf_, volume_, passive_);
+      taylor_ = std::make_unique<TaylorCorrection<D>>(ref_, materials_, materialOf_, volume_,
+                                                      passive_, moments);
     if (hourglass.enabled()) {
       pairCoefficient_ = hourglassPairCoefficients(ref_, materials_, materialOf_, volume_,
                                                    hourglass.alpha, passive_);

@@ -7,24 +7,34 @@
 #include <cmath>
 #include <variant>
 
+#include "model/Errors.hpp"
+
 namespace tlsph {
 
 template <int D>
-TaylorTermConstants taylorTermConstants(const std::vector<Material>& materials,
-                                        const std::vector<std::uint16_t>& materialOf,
-                                        const std::vector<double>& volume,
-                                        const std::vector<std::uint8_t>& passive) {
+TaylorTermConstants<D> taylorTermConstants(const std::vector<Material>& materials,
+                                           const std::vector<std::uint16_t>& materialOf,
+                                           const std::vector<double>& volume,
+                                           const std::vector<std::uint8_t>& passive,
+                                           const QuadratureMoments<D>& moments) {
   const std::size_t n = volume.size();
-  TaylorTermConstants c;
-  c.weight.assign(n, 0.0);
+  if (!moments.lattice() && (moments.offset.size() != n || moments.spread.size() != n))
+    throw SetupError("the particles' quadrature moments are not one per particle");
+  TaylorTermConstants<D> c;
+  c.offset.assign(n, Vec<D>::Zero());
+  c.spread.assign(n, Mat<D>::Zero());
   c.lambda.assign(n, 0.0);
   c.mu.assign(n, 0.0);
   c.smallStrain.assign(n, 0);
   for (std::size_t i = 0; i < n; ++i) {
     if (!passive.empty() && passive[i]) continue;
     const Material& material = materials[materialOf[i]];
-    const double l = std::pow(volume[i], 1.0 / D);
-    c.weight[i] = l * l / 12.0;
+    if (moments.lattice()) {
+      c.spread[i] = latticeSpread<D>(volume[i]);
+    } else {
+      c.offset[i] = moments.offset[i];
+      c.spread[i] = moments.spread[i];
+    }
     c.lambda[i] = elasticConstants(material).lambda;
     c.mu[i] = elasticConstants(material).mu;
     c.smallStrain[i] = std::holds_alternative<LinearElastic>(material);
@@ -72,11 +82,14 @@ TaylorCorrection<D>::TaylorCorrection(const ReferenceConfiguration<D>& ref,
                                       const std::vector<Material>& materials,
                                       const std::vector<std::uint16_t>& materialOf,
                                       const std::vector<double>& volume,
-                                      const std::vector<std::uint8_t>& passive)
+                                      const std::vector<std::uint8_t>& passive,
+                                      const QuadratureMoments<D>& moments)
     : ref_(ref), volume_(volume) {
   const auto& nb = ref.neighbours;
-  TaylorTermConstants c = taylorTermConstants<D>(materials, materialOf, volume, passive);
-  weight_ = std::move(c.weight);
+  TaylorTermConstants<D> c =
+      taylorTermConstants<D>(materials, materialOf, volume, passive, moments);
+  offset_ = std::move(c.offset);
+  spread_ = std::move(c.spread);
   lambda_ = std::move(c.lambda);
   mu_ = std::move(c.mu);
   smallStrain_ = std::move(c.smallStrain);
@@ -91,14 +104,16 @@ TaylorCorrection<D>::TaylorCorrection(const ReferenceConfiguration<D>& ref,
     }
 }
 
-template TaylorTermConstants taylorTermConstants<2>(const std::vector<Material>&,
-                                                    const std::vector<std::uint16_t>&,
-                                                    const std::vector<double>&,
-                                                    const std::vector<std::uint8_t>&);
-template TaylorTermConstants taylorTermConstants<3>(const std::vector<Material>&,
-                                                    const std::vector<std::uint16_t>&,
-                                                    const std::vector<double>&,
-                                                    const std::vector<std::uint8_t>&);
+template TaylorTermConstants<2> taylorTermConstants<2>(const std::vector<Material>&,
+                                                       const std::vector<std::uint16_t>&,
+                                                       const std::vector<double>&,
+                                                       const std::vector<std::uint8_t>&,
+                                                       const QuadratureMoments<2>&);
+template TaylorTermConstants<3> taylorTermConstants<3>(const std::vector<Material>&,
+                                                       const std::vector<std::uint16_t>&,
+                                                       const std::vector<double>&,
+                                                       const std::vector<std::uint8_t>&,
+                                                       const QuadratureMoments<3>&);
 template std::vector<Mat<2>> fitSecondDerivatives<2>(const ReferenceConfiguration<2>&,
                                                      const std::vector<double>&, Index);
 template std::vector<Mat<3>> fitSecondDerivatives<3>(const ReferenceConfiguration<3>&,

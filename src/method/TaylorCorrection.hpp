@@ -1,19 +1,33 @@
 // The second-order (Taylor) term of the strain energy's quadrature, plainly; the fast pass
-// fuses it into the force loops. E = sum_I V_I psi(F_I) is the midpoint rule on the
-// particles' cells: for an energy density varying quadratically across a cell it misses
-// V_I l_I^2 / 24 sum_a d^2 psi / dX_a^2 (l_I = V_I^(1/d)), in bending the fraction 1/n^2 of
-// the bending energy with n particles through the thickness. The term adds it back:
-//   E_q = sum_I V_I c_I / 2 sum_a e_a : C0 : e_a,   c_I = l_I^2 / 12,
-//   e_a = sym(F_I^T G_a),   G_a = dF/dX_a,   G_a(:, b) = sum_J (u_J - u_I) S_IJ(a, b),
-// C0 the material's small-strain stiffness (lambda, mu), S_IJ the second-derivative vectors
-// of the same weighted least-squares quadratic fit that gives the quadratic F. For the
-// linear-elastic material, whose energy is that of the small strain, e_a = sym(G_a).
-// Its exact gradient, with sigma_a = c_I C0 : e_a:
-//   through F:    P^q_I = sum_a G_a sigma_a    (added to P, sent through g_IJ)
+// fuses it into the force loops. Each particle stands for its weight w_I, a partition of unity
+// over the body (its lattice cell; a mesh node's hat), and E = sum_I V_I psi(F_I) takes psi
+// constant across it. Expanding psi about X_I,
+//   int w_I psi dV = V_I [psi_I + mu_a d psi/dX_a + 1/2 N_ab d^2 psi/dX_a dX_b]
+// exactly for a quadratic psi, with the weight's moments mu_I (the offset of its centroid) and
+// N_I (its second moment about X_I) of model/QuadratureMoments.hpp. The term adds the two
+// missing parts for the small-strain surrogate phi = 1/2 E : C0 : E of the energy density,
+// whose derivatives are d phi/dX_a = (C0 : E) : e_a and, up to the third derivatives of u,
+// d^2 phi/dX_a dX_b = e_a : C0 : e_b:
+//   E_q = sum_I V_I [1/2 sum_ab N_ab e_a : C0 : e_b + sum_a mu_a (C0 : E) : e_a],
+//   E = 1/2 (F^T F - 1),  e_a = dE/dX_a = sym(F_I^T G_a),  G_a = dF/dX_a,
+//   G_a(:, b) = sum_J (u_J - u_I) S_IJ(a, b),
+// C0 the material's small-strain stiffness (lambda, mu), S_IJ the second-derivative vectors of
+// the same weighted least-squares quadratic fit that gives the quadratic F. For the
+// linear-elastic material, whose energy is that of the small strain, E = sym(F - 1) and
+// e_a = sym(G_a). On a lattice cell, mu = 0 and N = c_I 1 (c_I = l_I^2 / 12, l_I = V_I^(1/d)):
+// E_q = sum_I V_I c_I / 2 sum_a e_a : C0 : e_a, in bending the fraction 1/n^2 of the bending
+// energy with n particles through the thickness that the midpoint rule misses.
+// Its exact gradient, with sigma_a = sum_b N_ab C0 : e_b + mu_a C0 : E and
+// tau = sum_a mu_a C0 : e_a:
+//   through F:    P^q_I = sum_a G_a sigma_a + F_I tau    (tau for linear elasticity; added to
+//                 P, sent through g_IJ)
 //   through G_a:  the hyperstress R_Ia = F_I sigma_a (sigma_a alone for linear elasticity),
 //                 dE_q = sum_I V_I sum_ab R_Ia(:, b) . dG_a(:, b), sent through S_IJ as P is
 //                 through g_IJ: f_J -= V_I sum_a R_Ia S_IJ(:, a), f_I += the same.
-// e_a is objective and zero for every affine field, so E_q >= 0 vanishes on rigid motions.
+// E and e_a are objective and zero for every rigid motion, e_a for every affine field: E_q
+// vanishes on both. Completing the square, the bracket is phi(E + mu_a e_a) - phi(E) +
+// 1/2 (N - mu mu^T)_ab e_a : C0 : e_b with N - mu mu^T the weight's central second moment
+// (positive semidefinite), so that E + E_q stays positive for small strains.
 // Only with the quadratic correction; particles on its linear fallback and passive ones carry
 // no term.
 #pragma once
@@ -25,21 +39,27 @@
 
 #include "materials/Material.hpp"
 #include "method/ReferenceConfiguration.hpp"
+#include "model/QuadratureMoments.hpp"
 #include "model/Types.hpp"
 
 namespace tlsph {
 
-// Per particle: the term's weight c_I = l_I^2 / 12 and its material's small-strain stiffness
-// C0 (lambda, mu); passive particles carry no term (weight 0).
+// Per particle: the moments of its weight (mu_I, N_I; a lattice cell's when `moments` is
+// empty) and its material's small-strain stiffness C0 (lambda, mu); passive particles carry no
+// term (zero moments).
+template <int D>
 struct TaylorTermConstants {
-  std::vector<double> weight, lambda, mu;
+  std::vector<Vec<D>> offset;  // mu_I
+  std::vector<Mat<D>> spread;  // N_I
+  std::vector<double> lambda, mu;
   std::vector<std::uint8_t> smallStrain;  // linear-elastic material: e_a = sym(G_a)
 };
 template <int D>
-TaylorTermConstants taylorTermConstants(const std::vector<Material>& materials,
-                                        const std::vector<std::uint16_t>& materialOf,
-                                        const std::vector<double>& volume,
-                                        const std::vector<std::uint8_t>& passive);
+TaylorTermConstants<D> taylorTermConstants(const std::vector<Material>& materials,
+                                           const std::vector<std::uint16_t>& materialOf,
+                                           const std::vector<double>& volume,
+                                           const std::vector<std::uint8_t>& passive,
+                                           const QuadratureMoments<D>& moments);
 
 // S_IJ of each of particle i's pairs (in its list's order): the second-derivative vectors of the
 // weighted least-squares quadratic fit of ReferenceConfiguration's quadratic correction.
@@ -56,7 +76,8 @@ class TaylorCorrection {
   // are inverted there, compiled once; the fast pass's set-up calls the same functions).
   TaylorCorrection(const ReferenceConfiguration<D>& ref, const std::vector<Material>& materials,
                    const std::vector<std::uint16_t>& materialOf, const std::vector<double>& volume,
-                   const std::vector<std::uint8_t>& passive = {});
+                   const std::vector<std::uint8_t>& passive = {},
+                   const QuadratureMoments<D>& moments = {});
 
   // S_IJ of pair k: d^2 u / dX_a dX_b at I = sum_J (u_J - u_I) S_IJ(a, b).
   const Mat<D>& secondDerivativeVector(Index k) const { return S_[k]; }
@@ -81,6 +102,13 @@ class TaylorCorrection {
     return 0.5 * (A + A.transpose());
   }
 
+  // E = 1/2 (F^T F - 1), or sym(F - 1) for the linear-elastic material.
+  Mat<D> greenStrain(Index i, const Mat<D>& F) const {
+    const Mat<D> I = Mat<D>::Identity();
+    if (smallStrain_[i]) return 0.5 * (F + F.transpose()) - I;
+    return 0.5 * (F.transpose() * F - I);
+  }
+
   // C0 : e
   Mat<D> smallStrainStress(Index i, const Mat<D>& e) const {
     return lambda_[i] * e.trace() * Mat<D>::Identity() + 2.0 * mu_[i] * e;
@@ -89,56 +117,101 @@ class TaylorCorrection {
   // E_q for the F and G of every particle.
   double energy(const std::vector<Mat<D>>& F, const std::vector<Gradients>& G) const {
     double E = 0.0;
-    for (Index i = 0; i < ref_.particleCount(); ++i)
+    for (Index i = 0; i < ref_.particleCount(); ++i) {
+      Gradients e, s;  // e_a and C0 : e_a
       for (int a = 0; a < D; ++a) {
-        const Mat<D> e = strain(i, F[i], G[i][a]);
-        E += 0.5 * volume_[i] * weight_[i] * (smallStrainStress(i, e).array() * e.array()).sum();
+        e[a] = strain(i, F[i], G[i][a]);
+        s[a] = smallStrainStress(i, e[a]);
       }
+      const Mat<D> S = smallStrainStress(i, greenStrain(i, F[i]));  // C0 : E
+      double Ei = 0.0;  // 1/2 sum_ab N_ab e_a : C0 : e_b + sum_a mu_a (C0 : E) : e_a
+      for (int a = 0; a < D; ++a) {
+        for (int b = 0; b < D; ++b)
+          Ei += 0.5 * spread_[i](a, b) * (e[a].array() * s[b].array()).sum();
+        Ei += offset_[i][a] * (S.array() * e[a].array()).sum();
+      }
+      E += volume_[i] * Ei;
+    }
     return E;
   }
 
-  // P^q_I = sum_a G_a sigma_a (none for the linear-elastic material, whose e_a has no F).
-  Mat<D> stress(Index i, const Mat<D>& F, const Gradients& G) const {
-    Mat<D> Pq = Mat<D>::Zero();
-    if (smallStrain_[i]) return Pq;
+  // sigma_a = sum_b N_ab C0 : e_b + mu_a C0 : E (sigma[0 .. D-1]) and tau = sum_a mu_a C0 : e_a.
+  struct Stresses {
+    Gradients sigma;
+    Mat<D> tau;
+  };
+  Stresses stresses(Index i, const Mat<D>& F, const Gradients& G) const {
+    Gradients s;  // C0 : e_a
     for (int a = 0; a < D; ++a)
-      Pq += G[a] * (weight_[i] * smallStrainStress(i, strain(i, F, G[a])));
+      s[a] = smallStrainStress(i, strain(i, F, G[a]));
+    const Mat<D> S = smallStrainStress(i, greenStrain(i, F));
+    Stresses t;
+    t.tau.setZero();
+    for (int a = 0; a < D; ++a) {
+      t.sigma[a] = offset_[i][a] * S;
+      for (int b = 0; b < D; ++b)
+        t.sigma[a] += spread_[i](a, b) * s[b];
+      t.tau += offset_[i][a] * s[a];
+    }
+    return t;
+  }
+
+  // P^q_I = sum_a G_a sigma_a + F tau (tau for the linear-elastic material, whose e_a has no F).
+  Mat<D> stress(Index i, const Mat<D>& F, const Gradients& G) const {
+    const Stresses t = stresses(i, F, G);
+    if (smallStrain_[i]) return t.tau;
+    Mat<D> Pq = F * t.tau;
+    for (int a = 0; a < D; ++a)
+      Pq += G[a] * t.sigma[a];
     return Pq;
   }
 
   // R_Ia = F_I sigma_a (sigma_a for the linear-elastic material).
   Gradients hyperstress(Index i, const Mat<D>& F, const Gradients& G) const {
+    const Stresses t = stresses(i, F, G);
     Gradients R;
-    for (int a = 0; a < D; ++a) {
-      const Mat<D> sigma = weight_[i] * smallStrainStress(i, strain(i, F, G[a]));
-      R[a] = smallStrain_[i] ? sigma : Mat<D>(F * sigma);
-    }
+    for (int a = 0; a < D; ++a)
+      R[a] = smallStrain_[i] ? t.sigma[a] : Mat<D>(F * t.sigma[a]);
     return R;
   }
 
   // The linearisation of stress() and hyperstress() about (F, G) in a direction whose
   // displacement gradient is dH and second gradients dG (the tangent stiffness's part of the
-  // term): with sigma_a = c_I C0 : e_a and de_a = sym(dH^T G_a + F^T dG_a) (sym(dG_a) for
-  // the linear-elastic material),
-  //   dP^q = sum_a (dG_a sigma_a + G_a dsigma_a),   dR_a = dH sigma_a + F dsigma_a.
+  // term): with de_a = sym(dH^T G_a + F^T dG_a) and dE = sym(F^T dH) (sym(dG_a) and sym(dH)
+  // for the linear-elastic material),
+  //   dsigma_a = sum_b N_ab C0 : de_b + mu_a C0 : dE,   dtau = sum_a mu_a C0 : de_a,
+  //   dP^q = sum_a (dG_a sigma_a + G_a dsigma_a) + dH tau + F dtau,   dR_a = dH sigma_a + F
+  //   dsigma_a
+  // (dP^q = dtau and dR_a = dsigma_a for the linear-elastic material).
   struct Linearised {
     Mat<D> stress;
     Gradients hyperstress;
   };
   Linearised linearised(Index i, const Mat<D>& F, const Gradients& G, const Mat<D>& dH,
                         const Gradients& dG) const {
-    Linearised d;
-    d.stress.setZero();
+    const bool small = smallStrain_[i];
+    const Stresses t = stresses(i, F, G);
+    Gradients ds;  // C0 : de_a
     for (int a = 0; a < D; ++a) {
-      const Mat<D> sigma = weight_[i] * smallStrainStress(i, strain(i, F, G[a]));
-      const Mat<D> A =
-          smallStrain_[i] ? dG[a] : Mat<D>(dH.transpose() * G[a] + F.transpose() * dG[a]);
-      const Mat<D> dsigma = weight_[i] * smallStrainStress(i, 0.5 * (A + A.transpose()));
-      if (smallStrain_[i]) {
+      const Mat<D> A = small ? dG[a] : Mat<D>(dH.transpose() * G[a] + F.transpose() * dG[a]);
+      ds[a] = smallStrainStress(i, 0.5 * (A + A.transpose()));
+    }
+    const Mat<D> B = small ? dH : Mat<D>(F.transpose() * dH);
+    const Mat<D> dS = smallStrainStress(i, 0.5 * (B + B.transpose()));  // C0 : dE
+    Linearised d;
+    Mat<D> dtau = Mat<D>::Zero();
+    for (int a = 0; a < D; ++a)
+      dtau += offset_[i][a] * ds[a];
+    d.stress = small ? dtau : Mat<D>(dH * t.tau + F * dtau);
+    for (int a = 0; a < D; ++a) {
+      Mat<D> dsigma = offset_[i][a] * dS;
+      for (int b = 0; b < D; ++b)
+        dsigma += spread_[i](a, b) * ds[b];
+      if (small) {
         d.hyperstress[a] = dsigma;
       } else {
-        d.stress += dG[a] * sigma + G[a] * dsigma;
-        d.hyperstress[a] = dH * sigma + F * dsigma;
+        d.stress += dG[a] * t.sigma[a] + G[a] * dsigma;
+        d.hyperstress[a] = dH * t.sigma[a] + F * dsigma;
       }
     }
     return d;
@@ -166,7 +239,8 @@ class TaylorCorrection {
   const ReferenceConfiguration<D>& ref_;
   const std::vector<double>& volume_;
   PairArray<Mat<D>> S_;                    // S_IJ, symmetric
-  std::vector<double> weight_;             // c_I = l_I^2 / 12; 0 where there is no term
+  std::vector<Vec<D>> offset_;             // mu_I; 0 where there is no term
+  std::vector<Mat<D>> spread_;             // N_I; 0 where there is no term
   std::vector<double> lambda_, mu_;        // C0
   std::vector<std::uint8_t> smallStrain_;  // linear-elastic material: e_a = sym(G_a)
 };

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "model/QuadratureMoments.hpp"
 #include "model/Types.hpp"
 
 namespace tlsph {
@@ -23,6 +24,11 @@ struct ParticleSet {
   std::vector<double> mass;               // m_I = rho0 V_I
   std::vector<std::uint16_t> material;    // index into the scene's materials
   std::vector<Motion> motion;
+  // The quadrature moments of each particle's weight (QuadratureMoments.hpp), mu_I and N_I.
+  // Empty: every particle is the centre of its lattice cell (mu = 0, N = l^2/12 1). A body
+  // meshed from a file sets them; particles added after that get their lattice cell's.
+  std::vector<Vec<D>> quadratureOffset;
+  std::vector<Mat<D>> quadratureSpread;
 
   Index size() const { return static_cast<Index>(referencePosition.size()); }
 
@@ -36,8 +42,14 @@ struct ParticleSet {
     mass.push_back(m);
     material.push_back(materialIndex);
     motion.push_back(how);
+    if (!quadratureOffset.empty()) {
+      quadratureOffset.push_back(Vec<D>::Zero());
+      quadratureSpread.push_back(latticeSpread<D>(V));
+    }
     return size() - 1;
   }
+
+  QuadratureMoments<D> quadratureMoments() const { return {quadratureOffset, quadratureSpread}; }
 
   Vec<D> currentPosition(Index i) const { return referencePosition[i] + displacement[i]; }
 };

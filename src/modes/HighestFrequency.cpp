@@ -57,7 +57,7 @@ SpectralEstimate highestFrequency(const Scene<D>& scene, const ReferenceConfigur
     return result;
   }
   TangentStiffness<D> K(ref, scene.materials, p.material, p.volume, hourglass, dofs,
-                        scene.quadrature);
+                        scene.quadrature, p.quadratureMoments());
   const std::vector<Mat<D>> identity(p.size(), Mat<D>::Identity());
   K.update(std::span<const Mat<D>>(identity));  // the reference state, u = 0
   Eigen::VectorXd inverseRootMass(n);

@@ -148,7 +148,7 @@ ModalResult<D> computeModes(const Scene<D>& scene, Solver<D>& solver,
   const Index n = D * dofs.size();
   if (n == 0) throw SetupError("the scene has no free particles: nothing can vibrate");
   TangentStiffness<D> K(solver.reference(), scene.materials, p.material, p.volume,
-                        scene.hourglass(), dofs, scene.quadrature);
+                        scene.hourglass(), dofs, scene.quadrature, p.quadratureMoments());
   K.update(solver.forces().deformationGradient());
   K.updateQuadrature(solver.forces().quadrature(), solver.forces().deformationGradient());
   Eigen::VectorXd mass(n);

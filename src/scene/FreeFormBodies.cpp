@@ -79,6 +79,10 @@ void Builder<D>::fillFreeFormBody() {
   const std::filesystem::path file = sceneRelative(config_, r.word("file"));
   std::vector<Vec<D>> X;
   std::vector<double> V;
+  // A mesh's nodes carry their hats' quadrature moments (GmshBody.hpp); particle files keep
+  // the lattice cells' (none given).
+  std::vector<Vec<D>> offset;
+  std::vector<Mat<D>> spread;
   std::map<std::string, SurfacePatch<D>> surfaces;
   std::map<std::string, std::vector<Index>> volumes;
   std::string what;
@@ -105,6 +109,8 @@ void Builder<D>::fillFreeFormBody() {
     }
     X = std::move(mesh.position);
     V = std::move(mesh.volume);
+    offset = std::move(mesh.offset);
+    spread = std::move(mesh.spread);
     for (auto& [group, s] : mesh.surfaces)
       surfaces.emplace(group, surfacePatch<D>(s));
     volumes = std::move(mesh.volumes);
@@ -135,8 +141,19 @@ void Builder<D>::fillFreeFormBody() {
   auto& p = setup_.scene.particles;
   const double rho = density(setup_.scene.materials[material]);
   double total = 0.0;
+  if (!offset.empty() && p.quadratureOffset.empty())  // particles before the body: lattice cells
+    for (Index j = 0; j < p.size(); ++j) {
+      p.quadratureOffset.push_back(Vec<D>::Zero());
+      p.quadratureSpread.push_back(latticeSpread<D>(p.volume[j]));
+    }
   for (Index i : order) {
     p.add(X[i], V[i], rho * V[i], material);
+    if (!offset.empty()) {  // (add() gave it a lattice cell's when there were moments before)
+      p.quadratureOffset.resize(p.size());
+      p.quadratureSpread.resize(p.size());
+      p.quadratureOffset.back() = offset[i];
+      p.quadratureSpread.back() = spread[i];
+    }
     setup_.body.push_back(0);
     setup_.ghost.push_back(0);
     total += V[i];

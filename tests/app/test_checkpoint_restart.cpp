@@ -308,6 +308,14 @@ TEST(CheckpointOrigin, ParticlesNumberedOtherwiseAreRefused) {
   EXPECT_NE(renumbered, digest);
   X[2].x() = std::nextafter(X[2].x(), 1.0);  // one position's last bit
   EXPECT_NE(particleDigest<2>(X), renumbered);
+  // The quadrature moments of a meshed body's particles count; none (lattice cells) add nothing.
+  EXPECT_EQ(particleDigest<2>(X, {}), particleDigest<2>(X));
+  std::vector<Vec<2>> offset(3, Vec<2>::Zero());
+  std::vector<Mat<2>> spread(3, Mat<2>::Identity());
+  const std::string withMoments = particleDigest<2>(X, {offset, spread});
+  EXPECT_NE(withMoments, particleDigest<2>(X));
+  spread[1](0, 1) = 1e-300;
+  EXPECT_NE(particleDigest<2>(X, {offset, spread}), withMoments);
 
   CheckpointOrigin saved;
   saved.version = "0.1.0";

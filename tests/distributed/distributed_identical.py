@@ -3,7 +3,8 @@
 
 For each scene below (2D and 3D, covering the clamps' mirrored ghosts, moving clamps,
 prescribed rotation, loads, gravity, probes, kinetic damping with the static stop, artificial
-viscosity, the textbook and energy hourglass forms, the Taylor quadrature and the nodal one),
+viscosity, the textbook and energy hourglass forms, the Taylor quadrature and the nodal one, a
+body meshed by gmsh whose particles carry their quadrature moments),
 `tlsph run` is run serially and under `mpirun -np R` (R given on the command line), and every
 output file is compared:
   - the VTU frames: serially one .vtu per frame, on R > 1 ranks a .pvtu naming one piece per
@@ -178,6 +179,52 @@ hourglass_content = true
 point = 0.15 0.06 0.05
 quantities = displacement velocity
 """,
+    # 2D strip meshed by gmsh (shape = mesh): its particles carry their nodes' quadrature
+    # moments into the Taylor term; a clamp on a named surface, gravity.
+    "mesh2d": """
+[scene]
+dimension = 2
+dx = 0.01
+[material.rubber]
+model = linear-elastic
+density = 1000
+youngs_modulus = 1e6
+poisson_ratio = 0.3
+[body.strip]
+shape = mesh
+file = strip.geo
+[clamp.root]
+surface = root
+[gravity]
+acceleration = 0 -9.81
+[time]
+end = 0.02
+[output]
+fields = displacement velocity
+every_steps = 80
+series_every_steps = 10
+[probe.tip]
+point = 0.2 0.02
+quantities = displacement
+""",
+}
+
+# Files the scenes read, written next to them.
+FILES = {
+    "strip.geo": """
+Point(1) = {0, 0, 0};
+Point(2) = {0.2, 0, 0};
+Point(3) = {0.2, 0.04, 0};
+Point(4) = {0, 0.04, 0};
+Line(1) = {1, 2};
+Line(2) = {2, 3};
+Line(3) = {3, 4};
+Line(4) = {4, 1};
+Curve Loop(1) = {1, 2, 3, 4};
+Plane Surface(1) = {1};
+Physical Curve("root") = {4};
+Physical Surface("strip") = {1};
+""",
 }
 
 BOOKS = {"external_work", "boundary_work", "damped", "total"}
@@ -297,6 +344,9 @@ def main():
     work = tempfile.mkdtemp(prefix="tlsph_mpi_")
     failures = 0
     try:
+        for name, text in FILES.items():
+            with open(os.path.join(work, name), "w") as f:
+                f.write(text)
         for name, text in SCENES.items():
             scene = os.path.join(work, name + ".ini")
             with open(scene, "w") as f:

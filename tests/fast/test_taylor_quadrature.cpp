@@ -3,10 +3,12 @@
 // tangent's product is the central difference of the force, and two particles' padded sums are
 // each particle's own. (The exactness for quadratic fields is pinned on the plain loops,
 // tests/method/test_taylor_correction.cpp; tests/fast/test_equivalence.cpp holds this pass to
-// them.)
+// them.) With general quadrature moments: the force and energy are the plain loops' and the
+// tangent is the difference of the force.
 #include <gtest/gtest.h>
 
 #include <bit>
+#include <cmath>
 #include <cstdint>
 
 #include "DifferencedStiffness.hpp"
@@ -14,6 +16,7 @@
 #include "explicit/Solver.hpp"
 #include "implicit/DofMap.hpp"
 #include "implicit/TangentStiffness.hpp"
+#include "method/PairForces.hpp"
 
 using namespace tlsph;
 using namespace tlsph::testing;
@@ -35,21 +38,44 @@ Scene<D> blockScene(const std::string& material, double alpha, double jitter, st
   return scene;
 }
 
+// Random moments: mu up to 0.3 dx per axis, N = mu mu^T + a positive definite central part.
 template <int D>
-void expectForceIsMinusEnergyGradient(const std::string& material, double alpha,
-                                      std::uint32_t seed) {
+void addRandomMoments(Scene<D>& scene, std::mt19937& rng) {
+  auto& p = scene.particles;
+  p.quadratureOffset.resize(p.size());
+  p.quadratureSpread.resize(p.size());
+  for (Index i = 0; i < p.size(); ++i) {
+    const Vec<D> mu = randomVector<D>(rng, 0.3 * kDx);
+    const Mat<D> B = randomMatrix<D>(rng, 0.15 * kDx);
+    p.quadratureOffset[i] = mu;
+    p.quadratureSpread[i] =
+        mu * mu.transpose() + B * B.transpose() + (kDx * kDx / 48.0) * Mat<D>::Identity();
+  }
+}
+
+template <int D>
+void expectForceIsMinusEnergyGradient(const std::string& material, double alpha, std::uint32_t seed,
+                                      bool moments = false) {
   std::mt19937 rng(seed);
-  ForceEvaluator<D> eval(blockScene<D>(material, alpha, 0.15, rng));
+  Scene<D> scene = blockScene<D>(material, alpha, 0.15, rng);
+  if (moments) addRandomMoments<D>(scene, rng);
+  ForceEvaluator<D> eval(scene);
   ASSERT_NE(eval.forces().quadrature(), nullptr);
   const Index n = eval.size();
-  const Mat<D> A = randomMatrix<D>(rng, 0.1);
+  // with moments a milder field, whose J > 0 at every particle: a NaN energy would pass the
+  // comparisons below
+  const double k = moments ? 0.25 : 1.0;
+  const Mat<D> A = randomMatrix<D>(rng, 0.1 * k);
   std::vector<Vec<D>> u(n);
   for (Index i = 0; i < n; ++i) {
     const Vec<D>& X = eval.scene().particles.referencePosition[i];
-    u[i] = A * X + X.squaredNorm() / kDx * randomVector<D>(rng, 0.01) +
-           randomVector<D>(rng, 0.03 * kDx);
+    u[i] = A * X + X.squaredNorm() / kDx * randomVector<D>(rng, 0.01 * k) +
+           randomVector<D>(rng, (moments ? 0.005 : 0.03) * kDx);
   }
   const auto f = eval.force(u);
+  if (moments) {
+    ASSERT_TRUE(std::isfinite(eval.energy(u))) << material << " D=" << D;
+  }
   const double h = 1e-6 * kDx;
   double scale = 0.0, error = 0.0;
   for (Index i = 0; i < n; ++i)
@@ -72,6 +98,52 @@ TEST(TaylorQuadrature, ForceIsMinusEnergyGradient2D) {
   for (const char* m : {"linear-elastic", "saint-venant-kirchhoff", "neo-hookean"})
     for (double alpha : {0.0, 10.0})
       expectForceIsMinusEnergyGradient<2>(m, alpha, 11);
+}
+
+TEST(TaylorQuadrature, ForceIsMinusEnergyGradientWithMoments) {
+  for (const char* m : {"linear-elastic", "neo-hookean"}) {
+    expectForceIsMinusEnergyGradient<2>(m, 10.0, 13, true);
+    expectForceIsMinusEnergyGradient<3>(m, 10.0, 14, true);
+  }
+}
+
+// With general moments the fused pass's force and energy are the plain loops'.
+template <int D>
+void expectPlainWithMoments(const std::string& material, std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  Scene<D> scene = blockScene<D>(material, 10.0, 0.15, rng);
+  addRandomMoments<D>(scene, rng);
+  ForceEvaluator<D> fast(scene);
+  ForceEvaluator<D, PairForces<D>> plain(scene);
+  const Index n = fast.size();
+  const Mat<D> A = randomMatrix<D>(rng, 0.05);
+  std::vector<Vec<D>> u(n);
+  for (Index i = 0; i < n; ++i) {
+    const Vec<D>& X = scene.particles.referencePosition[i];
+    u[i] = A * X + X.squaredNorm() / kDx * randomVector<D>(rng, 0.005) +
+           randomVector<D>(rng, 0.01 * kDx);
+  }
+  const auto ff = fast.force(u), fp = plain.force(u);
+  double scale = 0.0, error = 0.0;
+  for (Index i = 0; i < n; ++i) {
+    scale = std::max(scale, fp[i].cwiseAbs().maxCoeff());
+    error = std::max(error, (ff[i] - fp[i]).cwiseAbs().maxCoeff());
+  }
+  SCOPED_TRACE(material + " D=" + std::to_string(D));
+  EXPECT_GT(scale, 0.0);
+  EXPECT_LT(error, 1e-11 * scale);
+  for (const auto& F : plain.forces().deformationGradient())
+    ASSERT_GT(F.determinant(), 0.0);  // a field every material takes
+  const double Ef = fast.energy(u), Ep = plain.energy(u);
+  ASSERT_TRUE(std::isfinite(Ep));
+  EXPECT_NEAR(Ef, Ep, 1e-12 * std::abs(Ep));
+}
+
+TEST(TaylorQuadrature, PlainForceWithMoments) {
+  for (const char* m : {"linear-elastic", "saint-venant-kirchhoff", "neo-hookean"}) {
+    expectPlainWithMoments<2>(m, 15);
+    expectPlainWithMoments<3>(m, 16);
+  }
 }
 
 TEST(TaylorQuadrature, ForceIsMinusEnergyGradient3D) {
@@ -116,9 +188,11 @@ TEST(TaylorQuadrature, TwoParticleSumsAreEachParticlesOwn) {
 }
 
 template <int D>
-void expectTangentIsForceDifference(double alpha, std::uint32_t seed) {
+void expectTangentIsForceDifference(double alpha, std::uint32_t seed, bool moments = false,
+                                    const std::string& material = "neo-hookean") {
   std::mt19937 rng(seed);
-  Scene<D> scene = blockScene<D>("neo-hookean", alpha, 0.15, rng);
+  Scene<D> scene = blockScene<D>(material, alpha, 0.15, rng);
+  if (moments) addRandomMoments<D>(scene, rng);
   auto& p = scene.particles;
   // hold the first layer
   Prescription<D> clamp;
@@ -138,7 +212,7 @@ void expectTangentIsForceDifference(double alpha, std::uint32_t seed) {
   solver.reevaluate();
   DofMap<D> dofs(p, scene.mirrorGhosts);
   TangentStiffness<D> K(solver.reference(), scene.materials, p.material, p.volume,
-                        scene.hourglass(), dofs, scene.quadrature);
+                        scene.hourglass(), dofs, scene.quadrature, p.quadratureMoments());
   K.update(solver.forces().deformationGradient());
   K.updateQuadrature(solver.forces().quadrature(), solver.forces().deformationGradient());
   EXPECT_FALSE(K.assemblyExact());
@@ -162,6 +236,13 @@ TEST(TaylorQuadrature, TangentIsForceDifference) {
   expectTangentIsForceDifference<2>(0.0, 21);
   expectTangentIsForceDifference<2>(10.0, 22);
   expectTangentIsForceDifference<3>(10.0, 23);
+}
+
+TEST(TaylorQuadrature, TangentIsForceDifferenceWithMoments) {
+  expectTangentIsForceDifference<2>(10.0, 24, true);
+  expectTangentIsForceDifference<2>(0.0, 25, true, "linear-elastic");
+  expectTangentIsForceDifference<3>(10.0, 26, true);
+  expectTangentIsForceDifference<3>(10.0, 27, true, "saint-venant-kirchhoff");
 }
 
 }  // namespace

@@ -89,6 +89,38 @@ void expectPartitionOfUnity(const MeshedBody<D>& body) {
   }
 }
 
+// The nodes' hat moments: sum_I V_I (X_I + mu_I) = int x dV and
+// sum_I V_I (X_I X_I^T + mu_I X_I^T + X_I mu_I^T + N_I) = int x x^T dV, the solid's moments
+// integrated element by element without the hats (partition of unity); every node's central
+// second moment N_I - mu_I mu_I^T positive definite, and |mu_I| below the node's reach.
+template <int D>
+void expectMomentIdentities(const MeshedBody<D>& body, double tolerance) {
+  ASSERT_EQ(body.offset.size(), body.position.size());
+  ASSERT_EQ(body.spread.size(), body.position.size());
+  Vec<D> first = Vec<D>::Zero();
+  Mat<D> second = Mat<D>::Zero();
+  double worstOffset = 0;
+  for (std::size_t i = 0; i < body.position.size(); ++i) {
+    const Vec<D>& X = body.position[i];
+    const Vec<D>& mu = body.offset[i];
+    const double V = body.volume[i];
+    first += V * (X + mu);
+    second += V * (X * X.transpose() + mu * X.transpose() + X * mu.transpose() + body.spread[i]);
+    const Mat<D> central = body.spread[i] - mu * mu.transpose();
+    // positive definite: the leading principal minors (Sylvester)
+    EXPECT_GT(central(0, 0), 0.0) << i;
+    const double minor2 = central.template topLeftCorner<2, 2>().determinant();
+    EXPECT_GT(minor2, 0.0) << i;
+    EXPECT_GT(central.determinant(), 0.0) << i;
+    worstOffset = std::max(worstOffset, mu.norm() / std::sqrt(body.spread[i].trace()));
+  }
+  const double scale = std::sqrt(body.secondMoment.trace() * body.measure);
+  EXPECT_LT((first - body.firstMoment).norm(), tolerance * scale);
+  EXPECT_LT((second - body.secondMoment).norm(), tolerance * body.secondMoment.norm());
+  EXPECT_LT(worstOffset, 1.0);  // the hat's centroid lies within its spread
+  EXPECT_GT(worstOffset, 0.1);  // surface nodes: the hat leans into the body
+}
+
 // The outward normal of a linear facet (not normalised).
 Vec<2> normal(const MeshedBody<2>& body, const std::array<Index, 2>& f) {
   const Vec<2> a = body.position[f[1]] - body.position[f[0]];
@@ -206,6 +238,21 @@ TEST(GmshBody2D, RingAtSize16) {
   EXPECT_EQ(cellsWithCorners(body, 3), body.cellStart.size() - 1);
 }
 
+// The ring's moments: the nodes' sum is the element-by-element integral, and that is the ring's
+// (int x = 0, int x x^T = pi (r2^4 - r1^4) / 4 1) to the geometry's order.
+TEST(GmshBody2D, RingMomentsOfTheHats) {
+  for (const bool recombine : {false, true}) {
+    MeshOptions options;
+    options.recombine = recombine;
+    const auto body = meshBody<2>(data("ring.geo"), 1.0 / 16, options);
+    SCOPED_TRACE(recombine ? "quadrangles" : "triangles");
+    expectMomentIdentities(body, 1e-12);
+    const double inertia = kPi * (16.0 - 1.0) / 4;
+    EXPECT_LT(body.firstMoment.norm(), 1e-12 * inertia);
+    EXPECT_LT((body.secondMoment - inertia * Mat<2>::Identity()).norm(), 1e-3 * inertia);
+  }
+}
+
 TEST(GmshBody2D, RingConvergesAtTheOrderOfItsGeometry) {
   const double sizes[] = {1.0 / 8, 1.0 / 16, 1.0 / 32};
   double area[3], bore[3];
@@ -283,6 +330,26 @@ TEST(GmshBody2D, FirstOrderMshOnItsLinearGeometry) {
             << " (3 pi " << kRingArea << ")\n";
   EXPECT_NEAR(body.measure, shoelace, 1e-12 * shoelace);
   EXPECT_EQ(body.volumes.at("wall"), allParticles(body.position.size()));
+  // The moments on the linear geometry, independently: each cell a fan of triangles, whose
+  // int x = A (v0 + v1 + v2) / 3 and int x x^T = A / 12 (sum v v^T + s s^T), s = v0 + v1 + v2.
+  Vec<2> first = Vec<2>::Zero();
+  Mat<2> second = Mat<2>::Zero();
+  for (std::size_t c = 0; c + 1 < body.cellStart.size(); ++c)
+    for (Index k = body.cellStart[c] + 1; k + 1 < body.cellStart[c + 1]; ++k) {
+      const Vec<2>& v0 = body.position[body.cellNode[body.cellStart[c]]];
+      const Vec<2>& v1 = body.position[body.cellNode[k]];
+      const Vec<2>& v2 = body.position[body.cellNode[k + 1]];
+      const Vec<2> a = v1 - v0, b = v2 - v0;
+      const double A = std::abs(0.5 * (a.x() * b.y() - a.y() * b.x()));
+      const Vec<2> s = v0 + v1 + v2;
+      first += A / 3 * s;
+      second +=
+          A / 12 *
+          (v0 * v0.transpose() + v1 * v1.transpose() + v2 * v2.transpose() + s * s.transpose());
+    }
+  EXPECT_LT((body.firstMoment - first).norm(), 1e-12 * second.norm());
+  EXPECT_LT((body.secondMoment - second).norm(), 1e-12 * second.norm());
+  expectMomentIdentities(body, 1e-12);
 }
 
 // ----------------------------------------------------------------------------------------------
@@ -331,6 +398,7 @@ TEST(GmshBody3D, BoxWithCylindricalHole) {
   EXPECT_EQ(countRadial(body, "bore", Vec<2>(2, 2), [](double d) { return d < 0; }),
             bore.facets.size());
   EXPECT_EQ(body.volumes.at("block"), allParticles(body.position.size()));
+  expectMomentIdentities(body, 1e-12);
 }
 
 TEST(GmshBody3D, QuarterRingInTwoLayers) {
@@ -448,6 +516,22 @@ TEST(GmshBody3D, ClosedStlOfFlatFacesExactly) {
     ASSERT_TRUE((x.array() >= -1e-12).all() && (x.array() <= 2 + 1e-12).all());
     ASSERT_FALSE(x.x() > 1 + 1e-12 && x.y() > 1 + 1e-12);
   }
+  // Flat faces: the moments are the L's, [0, 2] x [0, 1] x [0, 1] and [0, 1] x [1, 2] x [0, 1].
+  Vec<3> first = Vec<3>::Zero();
+  Mat<3> second = Mat<3>::Zero();
+  for (const auto& [lo, hi] :
+       {std::pair{Vec<3>(0, 0, 0), Vec<3>(2, 1, 1)}, std::pair{Vec<3>(0, 1, 0), Vec<3>(1, 2, 1)}}) {
+    const double V = (hi - lo).prod();
+    const Vec<3> c = 0.5 * (lo + hi);
+    first += V * c;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        second(i, j) +=
+            i == j ? V * (lo[i] * lo[i] + lo[i] * hi[i] + hi[i] * hi[i]) / 3 : V * c[i] * c[j];
+  }
+  EXPECT_LT((body.firstMoment - first).norm(), 1e-9 * first.norm());
+  EXPECT_LT((body.secondMoment - second).norm(), 1e-9 * second.norm());
+  expectMomentIdentities(body, 1e-12);
 }
 
 // ----------------------------------------------------------------------------------------------

@@ -348,3 +348,43 @@ TEST(MeshBody, ErrorsNameTheSurfaceAndTheChoices) {
   EXPECT_NE(missing.find("[body.b] file"), std::string::npos) << missing;
   EXPECT_NE(missing.find("nowhere.step"), std::string::npos) << missing;
 }
+
+// A meshed body's particles carry their nodes' hat moments (GmshBody.hpp) in their new
+// numbering: the nodes' sum is the strip's first and second moments; a particle file's carry
+// none (lattice cells).
+TEST(MeshedBody, ParticlesCarryTheirNodesMoments) {
+  ScratchFolder dir;
+  std::ofstream(dir.path / "strip.geo")
+      << "Point(1) = {0, 0, 0};\nPoint(2) = {0.1, 0, 0};\nPoint(3) = {0.1, 0.02, 0};\n"
+         "Point(4) = {0, 0.02, 0};\nLine(1) = {1, 2};\nLine(2) = {2, 3};\nLine(3) = {3, 4};\n"
+         "Line(4) = {4, 1};\nCurve Loop(1) = {1, 2, 3, 4};\nPlane Surface(1) = {1};\n";
+  const auto setup = build<2>(
+      sceneHead(2, 0.005) + "[body.b]\nshape = mesh\nfile = strip.geo\nrecombine = false\n",
+      dir.path / "s.ini");
+  const auto& p = setup.scene.particles;
+  ASSERT_EQ(p.quadratureOffset.size(), std::size_t(p.size()));
+  ASSERT_EQ(p.quadratureSpread.size(), std::size_t(p.size()));
+  Vec<2> first = Vec<2>::Zero();
+  Mat<2> second = Mat<2>::Zero();
+  double offset = 0.0;
+  for (Index i = 0; i < p.size(); ++i) {
+    const Vec<2>& X = p.referencePosition[i];
+    const Vec<2>& mu = p.quadratureOffset[i];
+    first += p.volume[i] * (X + mu);
+    second += p.volume[i] *
+              (X * X.transpose() + mu * X.transpose() + X * mu.transpose() + p.quadratureSpread[i]);
+    offset = std::max(offset, mu.norm());
+  }
+  const double A = 0.1 * 0.02;
+  EXPECT_LT((first - A * Vec<2>(0.05, 0.01)).norm(), 1e-12 * A * 0.05);
+  Mat<2> exact;
+  exact << A * 0.01 / 3, A * 0.05 * 0.01, A * 0.05 * 0.01, A * 0.0004 / 3;
+  EXPECT_LT((second - exact).norm(), 1e-12 * exact.norm());
+  EXPECT_GT(offset, 0.1 * 0.005);  // the surface nodes' hats lean into the strip
+
+  std::ofstream(dir.path / "set.csv") << "x,y,volume\n0,0,1\n0,1,1\n1,0,1\n1,1,1\n";
+  const auto read = build<2>(sceneHead(2, 1.0) + "[body.b]\nshape = particles\nfile = set.csv\n",
+                             dir.path / "r.ini");
+  EXPECT_TRUE(read.scene.particles.quadratureOffset.empty());
+  EXPECT_TRUE(read.scene.particles.quadratureMoments().lattice());
+}
