@@ -2,6 +2,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <random>
@@ -15,6 +16,12 @@
 #include "model/Scene.hpp"
 
 namespace tlsph::testing {
+
+// The larger of a running worst error and a new one, NaN if either is: std::max(worst, NaN)
+// keeps worst, so an energy that turned NaN (J <= 0) would pass a difference check unseen.
+inline double worseOf(double worst, double error) {
+  return std::isnan(worst) || std::isnan(error) ? std::nan("") : std::max(worst, error);
+}
 
 // A block of counts[a] cells of size dx with every particle moved by up to
 // jitter * dx per axis; volumes stay dx^D.

@@ -101,7 +101,7 @@ void expectForceIsMinusBodyEnergyGradient(GradientCorrection correction, std::ui
       u[i][a] = saved - h;
       const double minus = evaluate(u, nullptr);
       u[i][a] = saved;
-      worst = std::max(worst, std::abs(-(plus - minus) / (2 * h) - f[i][a]));
+      worst = worseOf(worst, std::abs(-(plus - minus) / (2 * h) - f[i][a]));
     }
   EXPECT_LT(worst, 1e-6 * fmax) << D << "D";
 }

@@ -62,9 +62,9 @@ void expectForceIsMinusEnergyGradient(const std::string& material, double alpha,
   ForceEvaluator<D> eval(scene);
   ASSERT_NE(eval.forces().quadrature(), nullptr);
   const Index n = eval.size();
-  // with moments a milder field, whose J > 0 at every particle: a NaN energy would pass the
-  // comparisons below
-  const double k = moments ? 0.25 : 1.0;
+  // with moments a milder field, whose J > 0 at every particle (random moments make the Taylor
+  // term's stress large); a NaN energy fails the check below
+  const double k = moments ? 0.25 : 0.5;
   const Mat<D> A = randomMatrix<D>(rng, 0.1 * k);
   std::vector<Vec<D>> u(n);
   for (Index i = 0; i < n; ++i) {
@@ -73,9 +73,7 @@ void expectForceIsMinusEnergyGradient(const std::string& material, double alpha,
            randomVector<D>(rng, (moments ? 0.005 : 0.03) * kDx);
   }
   const auto f = eval.force(u);
-  if (moments) {
-    ASSERT_TRUE(std::isfinite(eval.energy(u))) << material << " D=" << D;
-  }
+  ASSERT_TRUE(std::isfinite(eval.energy(u))) << material << " D=" << D;
   const double h = 1e-6 * kDx;
   double scale = 0.0, error = 0.0;
   for (Index i = 0; i < n; ++i)
@@ -87,7 +85,7 @@ void expectForceIsMinusEnergyGradient(const std::string& material, double alpha,
       const double minus = eval.energy(v);
       const double fd = -(plus - minus) / (2.0 * h);
       scale = std::max(scale, std::abs(f[i][a]));
-      error = std::max(error, std::abs(fd - f[i][a]));
+      error = worseOf(error, std::abs(fd - f[i][a]));
     }
   SCOPED_TRACE(material + " alpha " + std::to_string(alpha) + " D=" + std::to_string(D));
   EXPECT_GT(scale, 0.0);

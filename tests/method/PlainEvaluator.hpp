@@ -44,7 +44,7 @@ double energyGradientError(Evaluator& eval, std::vector<Vec<D>> u, double h, dou
       u[i][a] = saved - h;
       const double minus = eval.energy(u);
       u[i][a] = saved;
-      worst = std::max(worst, std::abs(-(plus - minus) / (2 * h) - f[i][a]));
+      worst = worseOf(worst, std::abs(-(plus - minus) / (2 * h) - f[i][a]));
     }
   return worst;
 }
