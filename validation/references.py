@@ -295,6 +295,25 @@ def kirchhoff_plate_deflection(E, nu, t, a, q, coefficient=0.00126):
     return coefficient * q * a**4 / D
 
 
+# --------------------------------------------------------------------------------------------
+# Thick-walled cylinder (Lame), plane strain
+
+
+def lame_ring(E, nu, a, b, p):
+    """Ring a <= r <= b under internal pressure p with u(b) = 0 (the outer surface clamped),
+    plane strain: u_r = A r + B / r, A = -B / b^2, B from sigma_rr(a) = -p. Returns a function
+    r -> (u_r, sigma_rr, sigma_tt)."""
+    lam = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
+    mu = E / (2.0 * (1.0 + nu))
+    B = p / (2.0 * (lam + mu) / b**2 + 2.0 * mu / a**2)
+    A = -B / b**2
+
+    def at(r):
+        return (A * r + B / r, 2.0 * (lam + mu) * A - 2.0 * mu * B / r**2,
+                2.0 * (lam + mu) * A + 2.0 * mu * B / r**2)
+    return at
+
+
 if __name__ == "__main__":
     E, nu, rho = 1.0e7, 0.3, 1000.0
     b = h = 0.1
@@ -322,3 +341,7 @@ if __name__ == "__main__":
         wm = mindlin_clamped_square(1e7, 0.3, 0.05, 0.5, 1000.0, n=n)
         print("Mindlin Ritz n=%d: %.6e m  (Kirchhoff 0.00126: %.6e, ratio %.4f)" % (
             n, wm, wk, wm / wk))
+    ring = lame_ring(2.0e11, 0.3, 0.05, 0.1, 1.0e8)
+    print("Lame ring: u(a) = %.5e m, u(0.075) = %.5e m, sigma_rr(a) = %.5e Pa, "
+          "sigma_tt(a) = %.5e Pa" % (ring(0.05)[0], ring(0.075)[0], ring(0.05)[1],
+                                     ring(0.05)[2]))

@@ -272,6 +272,28 @@ COLUMNS = {
         ("Kt vs FEM %", lambda r: err(r, "kt_top")),
         ("Kt vs Peterson %", lambda r: err(r, "kt_top_vs_peterson")),
     ],
+    "lame_ring": [
+        ("u(a) [mm]", _mm("u_a", 6)),
+        ("u(a) error %", lambda r: err(r, "u_a")),
+        ("sigma_tt(a) [MPa]", lambda r: f3(val(r, "stt_a") / 1e6
+                                          if val(r, "stt_a") is not None else None, 2)),
+        ("sigma_tt(a) error %", lambda r: err(r, "stt_a")),
+        ("sigma_rr(a) error %", lambda r: err(r, "srr_a")),
+        ("u(0.075) error %", lambda r: err(r, "u_mid")),
+    ],
+    "plate_hole_fitted": [
+        ("Kt (node)", lambda r: f3(val(r, "kt_top"), 3)),
+        ("Kt vs FEM %", lambda r: err(r, "kt_top")),
+        ("Kt (kernel probe) vs FEM %", lambda r: err(r, "kt_top_kernel")),
+        ("end u_x [mm]", _mm("end_ux", 5)),
+        ("end u_x vs FEM %", lambda r: err(r, "end_ux")),
+    ],
+    "bracket": [
+        ("u_x(P) [mm]", _mm("ux_P", 5)),
+        ("u_x error vs FEM %", lambda r: err(r, "ux_P")),
+        ("u_z(P) [mm]", _mm("uz_P", 5)),
+        ("u_z error vs FEM %", lambda r: err(r, "uz_P")),
+    ],
 }
 COLUMNS["cook_membrane_incompressible"] = COLUMNS["cook_membrane"]
 
@@ -304,6 +326,10 @@ CONVERGENCE = {
                                      ("edge_mid_uy", "edge_mid_uy", "FEM")],
     "plate_hole": [("end_ux", "end_ux", "FEM"), ("kt_top", "kt_top", "FEM"),
                    ("kt_top_vs_peterson", "kt_top", "Peterson")],
+    "lame_ring": [("u_a", "u_a", "Lame"), ("stt_a", "stt_a", "Lame")],
+    "plate_hole_fitted": [("kt_top", "kt_top", "FEM"), ("end_ux", "end_ux", "FEM"),
+                          ("kt_top_kernel", "kt_top_kernel", "FEM")],
+    "bracket": [("ux_P", "ux_P", "FEM"), ("uz_P", "uz_P", "FEM")],
 }
 # Secondary errors shown in the summary (label, error name).
 SUMMARY_EXTRA = {
@@ -320,6 +346,9 @@ SUMMARY_EXTRA = {
     "cook_membrane_incompressible": [("u_x vs FEM", "corner_ux"),
                                      ("mid-edge u_y vs FEM", "edge_mid_uy")],
     "plate_hole": [("Kt (probe) vs FEM", "kt_top"), ("vs Peterson", "kt_top_vs_peterson")],
+    "lame_ring": [("sigma_tt(a) vs Lame", "stt_a")],
+    "plate_hole_fitted": [("end u_x vs FEM", "end_ux")],
+    "bracket": [("u_z(P) vs FEM", "uz_P")],
 }
 # The quantity an error is of, for legends and tables.
 ERROR_SYMBOL = {"period": "T", "period_vs_timoshenko": "T", "tip": "w", "tip_vs_fem": "w",
@@ -330,19 +359,22 @@ ERROR_SYMBOL = {"period": "T", "period_vs_timoshenko": "T", "tip": "w", "tip_vs_
                 "time_average_deflection_vs_fem": "time-averaged w",
                 "tip_uz": "tip u_z", "tip_ux": "tip u_x", "corner_uy": "corner u_y",
                 "corner_ux": "corner u_x", "edge_mid_uy": "mid-edge u_y", "end_ux": "end u_x",
-                "kt_top": "Kt (probe)", "kt_top_vs_peterson": "Kt (probe)"}
+                "kt_top": "Kt (probe)", "kt_top_vs_peterson": "Kt (probe)",
+                "u_a": "u(a)", "stt_a": "sigma_tt(a)", "kt_top_kernel": "Kt (kernel probe)",
+                "ux_P": "u_x(P)", "uz_P": "u_z(P)"}
 
 
 # Errors of displacement components taken along the reference's direction (run.py
 # pct_along): positive = larger than the reference in its own direction.
-ALONG = {"tip_uz", "tip_ux", "corner_uy", "corner_ux", "edge_mid_uy", "end_ux"}
+ALONG = {"tip_uz", "tip_ux", "corner_uy", "corner_ux", "edge_mid_uy", "end_ux", "ux_P", "uz_P"}
 
 
 PRIMARY_AGAINST = {"oscillating_plate": "thin plate", "cantilever_static": "FEM",
                    "cantilever_dynamic": "Timoshenko", "csm1": "Turek-Hron",
                    "csm3": "Turek-Hron", "clamped_plate": "FEM", "cantilever_large": "FEM",
                    "cook_membrane": "FEM", "cook_membrane_incompressible": "FEM",
-                   "plate_hole": "FEM"}
+                   "plate_hole": "FEM", "lame_ring": "Lame", "plate_hole_fitted": "FEM",
+                   "bracket": "FEM"}
 
 
 def error_label(name, against):
@@ -374,6 +406,13 @@ def reference_value(R, key, error_name):
         ("plate_hole", "end_ux"): ph.get("end_ux_fem"),
         ("plate_hole", "kt_top"): ph.get("kt_top_fem"),
         ("plate_hole", "kt_top_vs_peterson"): ph.get("kt_peterson"),
+        ("plate_hole_fitted", "end_ux"): ph.get("end_ux_fem"),
+        ("plate_hole_fitted", "kt_top"): ph.get("kt_top_fem"),
+        ("plate_hole_fitted", "kt_top_kernel"): ph.get("kt_top_fem"),
+        ("lame_ring", "u_a"): R.get("lame_ring", {}).get("u_a"),
+        ("lame_ring", "stt_a"): R.get("lame_ring", {}).get("stt_a"),
+        ("bracket", "ux_P"): R.get("bracket", {}).get("ux_P"),
+        ("bracket", "uz_P"): R.get("bracket", {}).get("uz_P"),
     })
     for case in ("cook_membrane", "cook_membrane_incompressible"):
         for k in ("corner_uy", "corner_ux", "edge_mid_uy"):
@@ -443,6 +482,8 @@ def twin_cell(runs, r):
     if t is None:
         return "%s; no %s twin" % (r["solver"], other)
     if t.get("outcome") == "skipped":
+        if t.get("predicted_memory_gb") is None:  # a twin skipped for its run time
+            return "%s; %s not run (%s)" % (r["solver"], other, t.get("skipped", ""))
         return "%s; %s not run (memory: %.0f GB predicted)" % (
             r["solver"], other, t.get("predicted_memory_gb") or 0)
     if not converged(t):
@@ -488,10 +529,15 @@ def readme(data, plots, plot_note):
     L.append("| threads | OMP_NUM_THREADS=%s, OMP_WAIT_POLICY=%s |" % (
         m.get("threads", "?"), meta.get("omp_wait_policy") or "(default)"))
     reused = sum(1 for r in runs if r.get("reused"))
-    skipped = sum(1 for r in runs if r.get("outcome") == "skipped")
-    L.append("| runs | %d%s, started %s%s |" % (
-        len(runs) - skipped, " (and %d Newton runs skipped for their predicted memory, not "
-        "run)" % skipped if skipped else "", meta.get("started", "?"),
+    skipped = sum(1 for r in runs if r.get("outcome") == "skipped" and
+                  r.get("predicted_memory_gb") is not None)
+    slow = sum(1 for r in runs if r.get("outcome") == "skipped" and
+               r.get("predicted_memory_gb") is None)
+    L.append("| runs | %d%s%s, started %s%s |" % (
+        len(runs) - skipped - slow, " (and %d Newton runs skipped for their predicted memory, "
+        "not run)" % skipped if skipped else "",
+        " (and %d damped twins not run for their estimated run time)" % slow if slow else "",
+        meta.get("started", "?"),
         "; %d of them reused from an earlier invocation of the same ladder (`--reuse`: same "
         "command, run after the scene file last changed; their wall times are those measured "
         "then)" % reused if reused else ""))
@@ -768,6 +814,9 @@ def solver_verdict(pairs):
         k = d["per_thickness"]
         if n is None:
             continue
+        if d.get("outcome") == "skipped":
+            rows.append((k, "newton", "damped not run (run time)", None))
+            continue
         if n.get("outcome") == "skipped":
             rows.append((k, "damped", "Newton not run (predicted %.0f GB)"
                          % (n.get("predicted_memory_gb") or float("nan")), None))
@@ -813,6 +862,13 @@ def solver_table(key, p, runs, variant):
     for d, n in pairs:
         skipped = n is not None and n.get("outcome") == "skipped"
         st = (n or {}).get("newton") or {}
+        if d.get("outcome") == "skipped":  # the damped twin, not run for its run time
+            rows.append([d["per_thickness"], particles(n), err(n, q), d.get("skipped", ""),
+                         "-", f3(n.get("wall_seconds"), 2), mem(n.get("peak_rss_mb")), "-",
+                         newton_stats(n), preconditioner_text(n),
+                         g(st.get("matrix_nonzeros"), 3), g(st.get("factor_nonzeros"), 3),
+                         "-"])
+            continue
         rows.append([
             d["per_thickness"], particles(d), err(n if converged(n) else d, q),
             "%s (%s steps)" % (f3(d.get("wall_seconds"), 1), d.get("steps") or "-"),
@@ -1140,6 +1196,26 @@ def references_section(R):
                      rich_text(ph.get("kt_top_fem_order")), ph["kt_top_fem_finest"],
                      ph["end_ux_fem"] * MM, ph.get("kt_peterson") or float("nan"),
                      ph.get("kt_heywood") or float("nan")))
+    lr = R.get("lame_ring")
+    if lr:
+        L.append("- **Lame ring** (`lame_ring.ini`): closed form of the thick-walled cylinder "
+                 "a = 0.05 <= r <= b = 0.1 m, plane strain, internal pressure 100 MPa, "
+                 "u(b) = 0 (the outer surface clamped): u_r = A r + B / r, A = -B / b^2, "
+                 "B = p / (2 (lambda + mu) / b^2 + 2 mu / a^2): u(a) = **%.5e m**, "
+                 "sigma_tt(a) = **%.4e Pa**, sigma_rr(a) = %.4e Pa, u(0.075) = %.5e m "
+                 "(validation/references.py `lame_ring`)." % (
+                     lr["u_a"], lr["stt_a"], lr["srr_a"], lr["u_mid"]))
+    if R.get("plate_hole_fitted") and ph:
+        L.append("- **Plate with a hole, fitted** (`plate_hole_fitted.ini`): the same FEM "
+                 "references as the plate with a hole (Kt = %.4f, u_x(0.4, 0.05) = %.5f mm)."
+                 % (ph["kt_top_fem"], ph["end_ux_fem"] * MM))
+    br = R.get("bracket")
+    if br:
+        L.append("- **L-bracket** (`bracket.ini`, geometry examples/bracket.geo): CalculiX "
+                 "C3D10 (validation/bracket_fem.py, %s), P = (0, 0, 0.06): u_x = **%.5f mm** "
+                 "(+- %.5f), u_z = **%.5f mm** (+- %.5f)." % (
+                     br.get("source"), br["ux_P"] * MM, br["uncertainty"]["ux_P"] * MM,
+                     br["uz_P"] * MM, br["uncertainty"]["uz_P"] * MM))
     L.append("")
     return L
 
@@ -1202,6 +1278,28 @@ NOTES = {
                   "not as a nodal value would; the field errors below compare the stresses "
                   "particle by particle.",
 }
+
+
+NOTES.update({
+    "lame_ring": "Body from gmsh (validation/geometry/lame_ring.geo, quadrangles): the "
+                 "particles are the mesh's corner nodes; the pressure acts on the \"bore\" "
+                 "nodes, the \"outer\" nodes are held (nodal clamp). 'Per thickness' = "
+                 "elements through the wall (0.05 m). u(a) and sigma_tt(a) are the means of "
+                 "the nodes at (a, 0) (u_x, sigma_yy) and (0, a) (u_y, sigma_xx), read by "
+                 "nearest-particle probes (the particle's own stress). u(0.075) from a "
+                 "kernel probe.",
+    "plate_hole_fitted": "The plate with a hole of `plate_hole.ini`, the body from gmsh "
+                         "(validation/geometry/plate_hole.geo, quadrangles fitted to the "
+                         "hole): nodal clamp on \"left\", the traction on \"right\" with "
+                         "each node's share of the edge. Kt from the node at the hole's "
+                         "top (nearest-particle probe, the particle's own stress); the kernel "
+                         "probe's smoothed Kt for comparison with `plate_hole`.",
+    "bracket": "The L-bracket of examples/bracket.ini (3D, gmsh tetrahedra from CAD, "
+               "particles = corner nodes; nodal clamp on the bore, pressure on the arm's "
+               "face). 'Per thickness' = elements through the 10 mm walls (dx = 5, 3.5, "
+               "2.5, 1.75 mm). u_x and u_z of the arm's top corner P = (0, 0, 0.06) from a "
+               "kernel probe, errors along the FEM's direction (positive = too soft).",
+})
 
 
 def problem_section(key, p, runs, R):

@@ -9,6 +9,7 @@ From the repository root (the build must exist: `bash scripts/setup.sh build`):
                                                       # errors checked against tolerances.json
   /usr/bin/python3 validation/run.py --report-only    # README.md and plots from results.json
   /usr/bin/python3 validation/run.py --derive-tolerances   # tolerances.json from results.json
+                                                      # (--only P: P's entries, others kept)
   /usr/bin/python3 validation/run.py --plan           # list the runs, run nothing
 
 `bash scripts/setup.sh validate` installs what is missing, builds and runs the full ladder.
@@ -67,6 +68,7 @@ import references as refs  # noqa: E402
 
 
 FEM_JSON = HERE / "fem" / "references.json"  # validation/fem.py's point values (committed)
+BRACKET_FEM_JSON = HERE / "bracket_fem.json"  # validation/bracket_fem.py's (committed)
 FEM_OUT = HERE / "fem" / "out"  # its VTU files (git-ignored), for `tlsph compare`
 
 # The FEM case (validation/fem.py CASES) of each problem that has one, and whether its VTU is
@@ -76,7 +78,7 @@ FEM_CASE = {"cantilever_static": "cantilever", "cantilever_dynamic": "cantilever
             "clamped_plate": "clamped_plate", "cantilever_large": "cantilever_large",
             "cook_membrane": "cook_membrane",
             "cook_membrane_incompressible": "cook_membrane_incompressible",
-            "plate_hole": "plate_hole"}
+            "plate_hole": "plate_hole", "plate_hole_fitted": "plate_hole"}
 FIELD_PROBLEMS = ["cantilever_static", "clamped_plate", "cantilever_large", "cook_membrane",
                   "cook_membrane_incompressible", "plate_hole"]
 
@@ -238,6 +240,18 @@ def compute_references(fem_path=FEM_JSON):
     c["kt_heywood"] = an.get("heywood_gross")
     c["traction"] = 1.0e5
     r["plate_hole"] = c
+    # The same plate fitted to the surface (gmsh): the same FEM references.
+    r["plate_hole_fitted"] = dict(c)
+    # Thick-walled cylinder (Lame), plane strain, outer surface clamped: closed form.
+    ring = refs.lame_ring(2.0e11, 0.3, 0.05, 0.1, 1.0e8)
+    r["lame_ring"] = {"u_a": ring(0.05)[0], "u_mid": ring(0.075)[0],
+                      "srr_a": ring(0.05)[1], "stt_a": ring(0.05)[2],
+                      "source": "Lame: u_r = A r + B / r, u(b) = 0, sigma_rr(a) = -p"}
+    # L-bracket: CalculiX C3D10, graded mesh ladder (validation/bracket_fem.py).
+    br = json.loads(BRACKET_FEM_JSON.read_text())["reference"]
+    r["bracket"] = {k: br[k]["reference"] for k in ("ux_P", "uz_P")}
+    r["bracket"].update(uncertainty={k: br[k]["uncertainty"] for k in ("ux_P", "uz_P")},
+                        source=rel(BRACKET_FEM_JSON) + ": " + br["ux_P"]["from"])
     r["fem"] = {"references": rel(fem_path), "generator": fem.get("generator"),
                 "ccx_version": fem.get("ccx_version"),
                 "value_used": "Richardson estimate of the reference series where its last three "
@@ -548,6 +562,44 @@ def extract_plate_hole(series, summary, R):
             "primary": "end_ux"}
 
 
+def extract_plate_hole_fitted(series, summary, R):
+    ref = R["plate_hole_fitted"]
+    ux = series["end_ux"][-1]
+    kt = series["hole_top_sxx"][-1] / ref["traction"]  # the node at the hole's top, its own
+    kt_k = series["hole_top_kernel_sxx"][-1] / ref["traction"]  # Shepard-smoothed
+    return {"values": {"end_ux": ux, "kt_top": kt, "kt_top_kernel": kt_k},
+            "errors": {"kt_top": pct(kt, ref["kt_top_fem"]),
+                       "end_ux": pct_along(ux, ref["end_ux_fem"]),
+                       "kt_top_kernel": pct(kt_k, ref["kt_top_fem"]),
+                       "kt_top_vs_peterson": pct(kt, ref.get("kt_peterson"))},
+            "primary": "kt_top"}
+
+
+def extract_lame_ring(series, summary, R):
+    """Radial displacement and hoop stress at the bore, read at its nodes on both axes: at
+    (a, 0) u_r = u_x, sigma_tt = sigma_yy; at (0, a) u_r = u_y, sigma_tt = sigma_xx."""
+    ref = R["lame_ring"]
+    u_x, u_y = series["bore_x_ux"][-1], series["bore_y_uy"][-1]
+    s_x, s_y = series["bore_x_syy"][-1], series["bore_y_sxx"][-1]
+    r_x, r_y = series["bore_x_sxx"][-1], series["bore_y_syy"][-1]
+    um = series["mid_x_ux"][-1]
+    v = {"u_a": 0.5 * (u_x + u_y), "u_a_x": u_x, "u_a_y": u_y, "stt_a": 0.5 * (s_x + s_y),
+         "stt_a_x": s_x, "stt_a_y": s_y, "srr_a": 0.5 * (r_x + r_y), "u_mid": um}
+    e = {"u_a": pct(v["u_a"], ref["u_a"]), "stt_a": pct(v["stt_a"], ref["stt_a"]),
+         "u_a_x": pct(u_x, ref["u_a"]), "u_a_y": pct(u_y, ref["u_a"]),
+         "stt_a_x": pct(s_x, ref["stt_a"]), "stt_a_y": pct(s_y, ref["stt_a"]),
+         "srr_a": pct(v["srr_a"], ref["srr_a"]), "u_mid": pct(um, ref["u_mid"])}
+    return {"values": v, "errors": e, "primary": "u_a"}
+
+
+def extract_bracket(series, summary, R):
+    ref = R["bracket"]
+    ux, uz = series["P_ux"][-1], series["P_uz"][-1]
+    return {"values": {"ux_P": ux, "uz_P": uz},
+            "errors": {"ux_P": pct_along(ux, ref["ux_P"]), "uz_P": pct_along(uz, ref["uz_P"])},
+            "primary": "ux_P"}
+
+
 # --------------------------------------------------------------------------------------------
 # Problems
 
@@ -557,7 +609,7 @@ class Problem:
                  static, qoi, unit, target=None, variants=None, sensitivity=None,
                  checked=None, cross=None, quick_variant=0, sens_variant=0,
                  variant_ladders=None, clamps=None, newton_memory=None, quick_twin=False,
-                 agree=None):
+                 agree=None, twin_skip=None):
         self.key, self.title, self.scene, self.dim = key, title, scene, dim
         self.thickness, self.ladder = thickness, ladder
         self.quick_dx, self.sens_dx = quick_dx, sens_dx
@@ -577,6 +629,8 @@ class Problem:
         self.newton_memory = newton_memory
         self.quick_twin = quick_twin
         self.agree = agree or []
+        # ladder resolutions whose twin is not run, with the reason (recorded as skipped)
+        self.twin_skip = twin_skip or {}
 
 
 # The 3D problems' sensitivity studies run at the coarsest ladder resolution (4 per thickness),
@@ -734,6 +788,31 @@ PROBLEMS = [
             extract_plate_hole, True, "end displacement u_x", "m",
             checked=["end_ux", "kt_top"], clamps=["left"],
             newton_memory=NEWTON_MEMORY["plate_hole"], agree=["end_ux", "kt_top"]),
+    # Bodies meshed by gmsh (particles = the mesh's corner nodes; nodal clamps and pressure
+    # loads on its physical groups). Newton memory anchors: the finest Newton runs measured
+    # (0.22, 1.37, 0.42 GB). "Per thickness": through the wall (Lame ring, 0.05 m),
+    # across the hole's diameter (0.02 m), through the bracket's 10 mm walls.
+    Problem("lame_ring", "Thick-walled cylinder (Lame) under internal pressure, gmsh body, "
+            "plane strain, static, 2D", "lame_ring.ini", 2, 0.05,
+            [0.05 / 8, 0.05 / 16, 0.05 / 32], 0.05 / 8, 0.05 / 8, extract_lame_ring, True,
+            "bore radial displacement u(a)", "m", target=("u_a", 1.0),
+            checked=["u_a", "stt_a"], clamps=["outer"], newton_memory=(32, 0.22, 2.5),
+            quick_twin=True, agree=["u_a", "stt_a"]),
+    Problem("plate_hole_fitted", "Plate with a central hole in tension, gmsh body fitted to "
+            "the hole, plane strain, static, 2D", "plate_hole_fitted.ini", 2, 0.02,
+            [0.0025, 0.00125, 0.000625], 0.0025, 0.0025, extract_plate_hole_fitted, True,
+            "Kt at the hole's top", "-", target=("kt_top", 3.0),
+            checked=["kt_top", "end_ux"], clamps=["left"], newton_memory=(32, 1.37, 2.5),
+            agree=["end_ux", "kt_top"],
+            # the damped twin's cost grows about 8 times per halving of dx (particles x steps)
+            twin_skip={0.000625: "damped twin not run: estimated ~45 min on the shared 2-core "
+                                 "machine (43 s at 8, 339 s at 16 across the hole; ~8x per "
+                                 "halving of dx)"}),
+    Problem("bracket", "L-bracket from CAD (examples/bracket.geo), gmsh body, static, 3D",
+            "bracket.ini", 3, 0.01, [0.005, 0.0035, 0.0025, 0.00175], 0.005, 0.005,
+            extract_bracket, True, "arm corner displacement u_x(P)", "m",
+            target=("ux_P", 1.0), checked=["ux_P", "uz_P"], clamps=["bolt"],
+            newton_memory=(6, 0.42, 3.0), agree=["ux_P", "uz_P"]),
 ]
 BY_KEY = {p.key: p for p in PROBLEMS}
 DEFAULTS = {"kernel.support": 2.1, "kernel.correction": "quadratic",
@@ -823,6 +902,8 @@ def plan_runs(quick, sensitivity, only, twins=True):
             runs.append(dict(problem=p.key, variant=name, dx=dx, kind="ladder", param=None,
                              value=None, overrides=o, solver=o["static.solver"],
                              twin=o["static.solver"]))
+            if dx in p.twin_skip:
+                runs[-1]["skip_reason"] = p.twin_skip[dx]
 
     def study_solver(p, o):
         """A static problem's sensitivity run: SENSITIVITY_SOLVER, given explicitly when the
@@ -1320,10 +1401,26 @@ def problems_table():
 MARGIN_PP, MARGIN_REL = 0.2, 0.10
 
 
-def derive_tolerances(results, path):
-    checks = {}
+def derive_tolerances(results, path, only=None):
+    """tolerances.json from results.json; with `only`, those problems' checks are derived and
+    the other problems' entries of the existing file kept as they are (their derivation
+    stays the commit that made it)."""
+    checks, kept_from = {}, None
+    if only:
+        try:
+            old = json.loads(Path(path).read_text())
+        except (OSError, ValueError):
+            old = None
+        if old:
+            own = {run_id(q, q.variants[q.quick_variant][0], q.quick_dx) for q in PROBLEMS
+                   if q.key in only}
+            checks = {k: v for k, v in old["checks"].items() if k not in own}
+            kept_from = {"problems": sorted({q.key for q in PROBLEMS} - set(only)),
+                         "derived_from": old.get("derived_from")}
     runs = {r["id"]: r for r in results["runs"]}
     for p in PROBLEMS:
+        if only and p.key not in only:
+            continue
         run = dict(problem=p.key, variant=p.variants[p.quick_variant][0], dx=p.quick_dx)
         rid = run_id(p, run["variant"], run["dx"])
         r = runs.get(rid)
@@ -1346,8 +1443,13 @@ def derive_tolerances(results, path):
                  % (MARGIN_PP, int(100 * MARGIN_REL)),
         "derived_from": {"commit": results["meta"].get("git", {}).get("commit"),
                          "generated": results["meta"].get("finished")},
-        "checks": checks,
+        "checks": {q_id: checks[q_id] for q_id in
+                   [run_id(q, q.variants[q.quick_variant][0], q.quick_dx) for q in PROBLEMS]
+                   if q_id in checks},
     }
+    if kept_from:
+        data["derived_from"]["problems"] = sorted(only)
+        data["kept"] = kept_from
     save_json(path, data)
     return data
 
@@ -1534,7 +1636,7 @@ def main(argv=None):
         results = load_results(results_path)
         if not results:
             raise SystemExit("no %s: run the ladder first" % rel(results_path))
-        data = derive_tolerances(results, args.tolerances)
+        data = derive_tolerances(results, args.tolerances, only)
         print("wrote %s (%d checks)" % (rel(args.tolerances), len(data["checks"])))
         return 0
 
@@ -1549,7 +1651,9 @@ def main(argv=None):
         for r in plan:
             p = BY_KEY[r["problem"]]
             note = ""
-            if r.get("solver") == "newton":
+            if r.get("skip_reason"):
+                note = "   # SKIPPED: " + r["skip_reason"]
+            elif r.get("solver") == "newton":
                 gb, basis = predict_newton_gb(p, per_thickness(p, r["dx"]), [])
                 if gb is not None:
                     note = "   # predicted %.2g GB%s" % (
@@ -1627,7 +1731,13 @@ def main(argv=None):
     for r in plan:
         p = BY_KEY[r["problem"]]
         rec = None
-        if r.get("solver") == "newton":
+        if r.get("skip_reason"):
+            rec = dict(r)
+            rec.pop("compare_fields", None)
+            rec.update(command=None, git=git["commit"], rc=None, outcome="skipped", qoi=None,
+                       per_thickness=per_thickness(p, r["dx"]), wall_runner=0.0,
+                       reused=False, skipped=r["skip_reason"])
+        elif r.get("solver") == "newton":
             measured = [(x["per_thickness"], x["peak_rss_mb"] / 1024.0) for x in records
                         if x["problem"] == p.key and x.get("solver") == "newton" and
                         x.get("peak_rss_mb") and x.get("outcome") == "converged"]
@@ -1685,6 +1795,11 @@ def main(argv=None):
             print("no report plots (%s): install python3-numpy python3-matplotlib, then "
                   "run with --report-only" % e)
     if args.check:
+        if only:  # --only: the other problems' checks are not this invocation's
+            own = {run_id(q, q.variants[q.quick_variant][0], q.quick_dx) for q in PROBLEMS
+                   if q.key in only}
+            tolerances = dict(tolerances, checks={k: v for k, v in tolerances["checks"].items()
+                                                  if k in own})
         rows, ok = check_against(tolerances, records)
         print()
         print("%-36s %-26s %10s %10s  %s" % ("run", "error", "error %", "max |%|", "verdict"))
