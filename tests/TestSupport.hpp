@@ -12,6 +12,7 @@
 #include "fast/TlsphForces.hpp"
 #include "geometry/Lattice.hpp"
 #include "materials/Material.hpp"
+#include "method/IntegrationConstraint.hpp"
 #include "method/ReferenceConfiguration.hpp"
 #include "model/Scene.hpp"
 
@@ -58,10 +59,11 @@ class ForceEvaluator {
  public:
   explicit ForceEvaluator(Scene<D> scene)
       : scene_(std::move(scene)),
-        ref_(buildReferenceConfiguration<D>(scene_.particles.referencePosition,
-                                            scene_.particles.volume,
-                                            Kernel<D>(scene_.kernel, scene_.supportRadius),
-                                            scene_.periodicBox, scene_.gradientCorrection)),
+        ref_(buildSceneReference<D>(scene_.particles.referencePosition, scene_.particles.volume,
+                                    Kernel<D>(scene_.kernel, scene_.supportRadius),
+                                    scene_.periodicBox, scene_.gradientCorrection,
+                                    scene_.quadrature, scene_.particles.quadratureMoments(),
+                                    scene_.particles.boundaryArea)),
         forces_(ref_, scene_.materials, scene_.particles.material, scene_.particles.volume,
                 scene_.hourglass(), scene_.quadrature, scene_.viscosity, 0.5 * scene_.supportRadius,
                 {}, scene_.particles.quadratureMoments()) {}

@@ -32,8 +32,12 @@ void printSetup(const SceneSetup<D>& setup, const Solver<D>& solver) {
             << " m = " << setup.scene.supportRadius / setup.dx << " dx, "
             << gradientCorrectionName(setup.scene.gradientCorrection) << " gradient correction, "
             << (setup.scene.quadrature == Quadrature::Taylor ? "Taylor-corrected" : "nodal")
-            << " quadrature)\n"
-            << "hourglass    alpha = " << setup.scene.hourglassCoefficient
+            << " quadrature)\n";
+  if (const auto& ic = solver.integrationConstraint(); ic.applied)
+    std::cout << "integration  gradient vectors corrected for the boundary's area vectors: defect "
+              << ic.defectBefore << " -> " << ic.defectAfter << " of the largest a_I ("
+              << ic.iterations << " CG iterations)\n";
+  std::cout << "hourglass    alpha = " << setup.scene.hourglassCoefficient
             << (setup.scene.hourglassCoefficient == 0
                     ? std::string(" (off)")
                     : std::string(", form ") + hourglassFormName(setup.scene.hourglassForm) +

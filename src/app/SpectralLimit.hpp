@@ -21,9 +21,10 @@ SpectralEstimate estimateSpectralStep(const Scene<D>& scene, const Solver<D>& so
   SpectralEstimate f;
   std::vector<double> numbers(5, 0.0);
   if (comm->rank() == 0) {
-    const auto whole = buildReferenceConfiguration<D>(
+    const auto whole = buildSceneReference<D>(
         scene.particles.referencePosition, scene.particles.volume,
-        Kernel<D>(scene.kernel, scene.supportRadius), scene.periodicBox, scene.gradientCorrection);
+        Kernel<D>(scene.kernel, scene.supportRadius), scene.periodicBox, scene.gradientCorrection,
+        scene.quadrature, scene.particles.quadratureMoments(), scene.particles.boundaryArea);
     f = highestFrequency(scene, whole);
     numbers = {f.made ? 1.0 : 0.0, f.lambda, double(f.particle), double(f.products), f.seconds};
   }

@@ -16,6 +16,7 @@
 
 #include "distributed/Communicator.hpp"
 #include "distributed/DomainPartition.hpp"
+#include "method/IntegrationConstraint.hpp"
 #include "method/Kernel.hpp"
 #include "method/NeighbourList.hpp"
 #include "method/ReferenceConfiguration.hpp"
@@ -136,9 +137,10 @@ template <int D>
 ReferenceConfiguration<D> buildPairData(const Scene<D>& scene, const Kernel<D>& kernel,
                                         const DistributionPlan& plan, Communicator* comm) {
   auto build = [&](const std::vector<Index>* rows) {
-    return buildReferenceConfiguration<D>(scene.particles.referencePosition, scene.particles.volume,
-                                          kernel, scene.periodicBox, scene.gradientCorrection,
-                                          kDefaultMinCorrectionCondition, rows);
+    return buildSceneReference<D>(scene.particles.referencePosition, scene.particles.volume, kernel,
+                                  scene.periodicBox, scene.gradientCorrection, scene.quadrature,
+                                  scene.particles.quadratureMoments(), scene.particles.boundaryArea,
+                                  rows);
   };
   if (!plan.active) return build(nullptr);
   ReferenceConfiguration<D> ref;

@@ -113,6 +113,9 @@ class Solver {
     return comm_ ? plan_.neighbours : neighbourStatsOf(ref_.neighbours);
   }
   const FallbackSummary& linearFallback() const { return fallback_; }
+  const IntegrationConstraintSummary& integrationConstraint() const {
+    return ref_.integrationConstraint;
+  }
   // The reference neighbours of particle i (a distributed rank keeps lists for its particles
   // and halo only; another particle's is searched for).
   std::vector<Index> neighboursOf(Index i) const {

@@ -49,6 +49,14 @@ GradientCorrection parseGradientCorrection(const std::string& name);  // invalid
 const char* quadratureName(Quadrature q);
 Quadrature parseQuadrature(const std::string& name);  // invalid_argument
 
+// What the integration constraint (IntegrationConstraint.hpp) did to the gradient vectors.
+struct IntegrationConstraintSummary {
+  bool applied = false;
+  double defectBefore = 0.0;  // max_I |a_I - d_I| / max_I |a_I|
+  double defectAfter = 0.0;
+  int iterations = 0;  // conjugate-gradient iterations
+};
+
 template <int D>
 struct ReferenceConfiguration {
   NeighbourList neighbours;
@@ -76,6 +84,8 @@ struct ReferenceConfiguration {
   // Built for some particles only (buildReferenceConfiguration's rows): 1 for those; empty
   // when built for all.
   std::vector<std::uint8_t> rowMask;
+  // The gradient vectors' correction for the integration constraint (mesh bodies).
+  IntegrationConstraintSummary integrationConstraint;
 
   Index particleCount() const { return neighbours.particleCount(); }
   // For reversePairValues: null when every particle has its list.

@@ -29,6 +29,11 @@ struct ParticleSet {
   // meshed from a file sets them; particles added after that get their lattice cell's.
   std::vector<Vec<D>> quadratureOffset;
   std::vector<Mat<D>> quadratureSpread;
+  // a_I = int lambda_I n dA over the body's whole boundary, for the integration constraint
+  // (method/IntegrationConstraint.hpp). Empty: not known (lattice bodies, particle files), and
+  // the gradient vectors stay as fitted. A body meshed from a file sets it and is the scene's
+  // only body.
+  std::vector<Vec<D>> boundaryArea;
 
   Index size() const { return static_cast<Index>(referencePosition.size()); }
 
@@ -46,6 +51,7 @@ struct ParticleSet {
       quadratureOffset.push_back(Vec<D>::Zero());
       quadratureSpread.push_back(latticeSpread<D>(V));
     }
+    if (!boundaryArea.empty()) boundaryArea.push_back(Vec<D>::Zero());
     return size() - 1;
   }
 

@@ -75,6 +75,7 @@ class Builder {
     readMaterials();
     readDiscretisation();
     fillBodies();
+    checkIntegrationConstraint();
     readRegions();
     addClamps();
     readPrescriptions();
@@ -117,6 +118,7 @@ class Builder {
   // (FreeFormBodies.cpp); the named surfaces conditions refer to.
   bool freeFormBodyGiven() const;
   void fillFreeFormBody();
+  void checkIntegrationConstraint();
   const SurfacePatch<D>& namedSurface(SectionReader& r, const std::string& key = "surface");
 
   // [clamp.NAME], [prescribe.NAME] (ConditionSections.cpp).
@@ -142,6 +144,7 @@ class Builder {
   Eigen::AlignedBox<double, D> bodyBox_;
   std::size_t maxParticles_ = 0;
   double supportRatio_ = 2.0;
+  bool integrationConstraint_ = false;  // [kernel] integration_constraint
   Index bodyCount_ = 0;
   std::map<std::array<long, D>, Index> latticeIndex_;  // lattice point -> body particle
   std::array<LatticeAxis, D> lattice_{};               // the bodies' lattice

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "geometry/BoundaryArea.hpp"
 #include "geometry/GmshBody.hpp"
 #include "geometry/LocalityOrder.hpp"
 #include "io/ParticleFile.hpp"
@@ -83,6 +84,7 @@ void Builder<D>::fillFreeFormBody() {
   // the lattice cells' (none given).
   std::vector<Vec<D>> offset;
   std::vector<Mat<D>> spread;
+  std::vector<Vec<D>> boundary;  // a_I of the whole boundary (mesh bodies)
   std::map<std::string, SurfacePatch<D>> surfaces;
   std::map<std::string, std::vector<Index>> volumes;
   std::string what;
@@ -107,6 +109,8 @@ void Builder<D>::fillFreeFormBody() {
     } catch (const GeometryError& e) {
       throw r.error("file", e.what());
     }
+    if (integrationConstraint_)
+      boundary = boundaryAreaVectors<D>(mesh.position, mesh.cellStart, mesh.cellNode);
     X = std::move(mesh.position);
     V = std::move(mesh.volume);
     offset = std::move(mesh.offset);
@@ -153,6 +157,10 @@ void Builder<D>::fillFreeFormBody() {
       p.quadratureSpread.resize(p.size());
       p.quadratureOffset.back() = offset[i];
       p.quadratureSpread.back() = spread[i];
+    }
+    if (!boundary.empty()) {  // the only body: every particle has its a_I
+      p.boundaryArea.resize(p.size());
+      p.boundaryArea.back() = boundary[i];
     }
     setup_.body.push_back(0);
     setup_.ghost.push_back(0);
@@ -224,11 +232,24 @@ const SurfacePatch<D>& Builder<D>::namedSurface(SectionReader& r, const std::str
   return setup_.surfaces.at(r.word(key, std::nullopt, known));
 }
 
+// [kernel] integration_constraint needs the boundary's area vectors, which only a body meshed
+// from a CAD or mesh file has.
+template <int D>
+void Builder<D>::checkIntegrationConstraint() {
+  if (!integrationConstraint_ || !setup_.scene.particles.boundaryArea.empty()) return;
+  throw InputError(config_.where("kernel", "integration_constraint"), "kernel",
+                   "integration_constraint",
+                   "needs the body's boundary, which a body meshed from a CAD or mesh file "
+                   "(shape = mesh) has; lattice bodies and particle files have none");
+}
+
 template bool Builder<2>::freeFormBodyGiven() const;
 template void Builder<2>::fillFreeFormBody();
+template void Builder<2>::checkIntegrationConstraint();
 template const SurfacePatch<2>& Builder<2>::namedSurface(SectionReader&, const std::string&);
 template bool Builder<3>::freeFormBodyGiven() const;
 template void Builder<3>::fillFreeFormBody();
+template void Builder<3>::checkIntegrationConstraint();
 template const SurfacePatch<3>& Builder<3>::namedSurface(SectionReader&, const std::string&);
 
 }  // namespace tlsph::scene_build

@@ -36,6 +36,9 @@ void Builder<D>::readDiscretisation() {
                   "taylor needs correction = quadratic (its second derivatives come from the "
                   "quadratic fit)");
   if (setup_.scene.quadrature == Quadrature::Taylor) warnNearlyIncompressible();
+  // The gradient vectors corrected so that a uniform stress balances its tractions at every
+  // particle (method/IntegrationConstraint.hpp): needs the boundary of a mesh body.
+  integrationConstraint_ = k.flag("integration_constraint", false);
   k.finish();
   SectionReader h(config_, "hourglass");
   setup_.scene.hourglassCoefficient = h.nonNegative("alpha", 10.0);

@@ -72,7 +72,9 @@ SceneSetup<D> buildScene(const Config& config) {
     std::ostringstream spacing;
     spacing << std::setprecision(17) << factor * dx;
     try {
-      Config coarse = config.with("scene.dx", spacing.str(), "multigrid coarsening");
+      // The coarse levels only precondition: they skip the integration constraint's solve.
+      Config coarse = config.with("scene.dx", spacing.str(), "multigrid coarsening")
+                          .with("kernel.integration_constraint", "false", "multigrid coarsening");
       return std::make_unique<Scene<D>>(scene_build::Builder<D>(coarse).build().scene);
     } catch (const std::exception&) {
       return nullptr;  // too coarse for this geometry: no such level
