@@ -138,7 +138,9 @@ int runOrCheck(const Config& config, bool run, bool progress, const std::string&
     const NewtonStatistics& n = *s.newton;
     std::cout << "\nNewton       " << n.loadSteps << " load steps, " << n.iterations
               << " iterations";
-    if (n.krylovIterations > 0) std::cout << ", " << n.krylovIterations << " CG iterations";
+    if (n.krylovIterations > 0)
+      std::cout << ", " << n.krylovIterations
+                << (n.linearSolver.starts_with("BiCGSTAB") ? " BiCGSTAB" : " CG") << " iterations";
     if (n.levels > 1)
       std::cout << ", " << n.factorisations << " preconditioner set-ups (" << n.linearSolver
                 << "; coarsest matrix " << n.nonZeros << " stored entries, factor "

@@ -23,6 +23,7 @@
 #include "explicit/Diagnostics.hpp"
 #include "explicit/Solver.hpp"
 #include "output/VtuSeriesWriter.hpp"
+#include "scene/InputError.hpp"
 #include "scene/SceneSetup.hpp"
 
 namespace tlsph {
@@ -81,6 +82,12 @@ RunSummary runSimulation(SceneSetup<D>& setup, const RunOptions& options, OnStar
     throw SetupError(
         "the Newton solver ([static] solver = newton) runs on one rank only: start "
         "it without mpirun (or with -np 1), or use solver = damped");
+  // A rank holds the displacements of its particles and their halo only, not necessarily of
+  // every corner of the facets its particles share.
+  if (comm && comm->size() > 1 && !setup.followingLoad.empty())
+    throw InputError(setup.followingWhere, setup.followingLoad, "follow",
+                     "a following pressure runs on one rank only: start it without mpirun (or "
+                     "with -np 1), or make the pressure dead (follow = false)");
   Solver<D> solver(setup.scene, setup.solver, comm);
   applySpectralStep(setup, solver);
   onStart(solver);

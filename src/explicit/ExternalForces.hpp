@@ -1,5 +1,6 @@
 // The scene's body forces and loads (Neumann conditions) on each particle at a time t, each
-// scaled by its ramp.
+// scaled by its ramp. A following pressure (FollowingPressure.hpp) is evaluated on the
+// particles' present displacements, so update() comes after every move.
 #pragma once
 
 #include <vector>
@@ -31,6 +32,10 @@ class ExternalForces {
       force_[i] = p.mass[i] * g;
     for (const auto& load : scene_->loads) {
       const double f = load.ramp.factor(t);
+      if (load.following) {
+        load.following->addForce(p.referencePosition, p.displacement, f, force_);
+        continue;
+      }
       for (std::size_t k = 0; k < load.particles.size(); ++k)
         force_[load.particles[k]] += f * load.force[k];
     }

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 
+#include "implicit/BiCgStab.hpp"
 #include "implicit/ConjugateGradients.hpp"
 
 namespace tlsph {
@@ -65,9 +66,16 @@ NewtonSolver<D>::NewtonSolver(Scene<D>& scene, Solver<D>& solver, const NewtonSe
       }
     }
   }
+  for (const auto& load : scene.loads)
+    following_ = following_ || load.following.has_value();
+  if (following_) {
+    variation_.resize(scene.particles.size());
+    loadProduct_.resize(scene.particles.size());
+  }
   statistics_.linearSolver = multigrid_ ? multigrid_->description() : SparseCholesky::name();
-  if (multigrid_ || !tangent_.assemblyExact())
-    statistics_.linearSolver = "conjugate gradients preconditioned by " + statistics_.linearSolver;
+  if (multigrid_ || !tangent_.assemblyExact() || following_)
+    statistics_.linearSolver =
+        std::string(krylovName()) + " preconditioned by " + statistics_.linearSolver;
 }
 
 template <int D>
@@ -78,8 +86,8 @@ void NewtonSolver<D>::useCholesky(const std::string& why) {
   multigrid_.reset();
   factorised_ = false;
   statistics_.levels = 1;
-  statistics_.linearSolver = "conjugate gradients preconditioned by " + SparseCholesky::name() +
-                             " (multigrid given up: " + why + ")";
+  statistics_.linearSolver = std::string(krylovName()) + " preconditioned by " +
+                             SparseCholesky::name() + " (multigrid given up: " + why + ")";
 }
 
 template <int D>
@@ -243,7 +251,25 @@ bool NewtonSolver<D>::factorise(std::string& why) {
   return factorised_;
 }
 
-// Preconditioned conjugate gradients on the exact K; false on negative curvature.
+template <int D>
+void NewtonSolver<D>::applyTangent(const Eigen::VectorXd& v, Eigen::VectorXd& Kv) {
+  tangent_.apply(v, Kv);
+  if (!following_) return;
+  // The pressures act on every particle of their facets: the variation of all of them (T v),
+  // and the product back onto the unknowns (T^T), as for the forces.
+  dofs_.expand(v, variation_);
+  std::fill(loadProduct_.begin(), loadProduct_.end(), Vec<D>::Zero());
+  const auto& p = scene_.particles;
+  for (const auto& load : scene_.loads)
+    if (load.following)
+      load.following->addStiffnessProduct(p.referencePosition, p.displacement,
+                                          load.ramp.factor(loadTime_), variation_, loadProduct_);
+  dofs_.gather(loadProduct_, loadStiffness_);
+  Kv += loadStiffness_;
+}
+
+// Preconditioned conjugate gradients on the exact K (BiCGSTAB with a following pressure); false
+// on negative curvature, a breakdown or a stall.
 template <int D>
 bool NewtonSolver<D>::solveLinear(const Eigen::VectorXd& r, Eigen::VectorXd& du, std::string& why) {
   const auto t0 = Clock::now();
@@ -253,9 +279,20 @@ bool NewtonSolver<D>::solveLinear(const Eigen::VectorXd& r, Eigen::VectorXd& du,
   const double target =
       std::max(settings_.linearTolerance * r.norm(), 0.1 * settings_.tolerance * forceScale);
   du = precondition(r);
-  const ConjugateGradientResult cg = conjugateGradients(
-      [&](const Eigen::VectorXd& v, Eigen::VectorXd& Kv) { tangent_.apply(v, Kv); },
-      [&](const Eigen::VectorXd& v) { return precondition(v); }, r, du, target, kMaxKrylov, kStall);
+  ConjugateGradientResult cg;
+  if (following_) {
+    const BiCgStabResult b =
+        biCgStab([&](const Eigen::VectorXd& v, Eigen::VectorXd& Kv) { applyTangent(v, Kv); },
+                 [&](const Eigen::VectorXd& v) { return precondition(v); }, r, du, target,
+                 kMaxKrylov, kStall);
+    cg.iterations = b.iterations;
+    cg.residual = b.residual;
+  } else {
+    cg = conjugateGradients(
+        [&](const Eigen::VectorXd& v, Eigen::VectorXd& Kv) { tangent_.apply(v, Kv); },
+        [&](const Eigen::VectorXd& v) { return precondition(v); }, r, du, target, kMaxKrylov,
+        kStall);
+  }
   const int iterations = cg.iterations;
   statistics_.krylovIterations += iterations;
   statistics_.solveSeconds += seconds(t0);
@@ -270,9 +307,10 @@ bool NewtonSolver<D>::solveLinear(const Eigen::VectorXd& r, Eigen::VectorXd& du,
   // the residual still serves Newton.
   if (cg.residual > target && cg.residual > 0.5 * r.norm()) {
     std::ostringstream msg;
-    msg << "the linear solve stalled after " << iterations
-        << " conjugate-gradient iterations at an out-of-balance force of " << cg.residual
-        << " (the Newton target is " << settings_.tolerance * forceScale
+    msg << "the linear solve stalled after " << iterations << " "
+        << (following_ ? "BiCGSTAB" : "conjugate-gradient")
+        << " iterations at an out-of-balance force of " << cg.residual << " (the Newton target is "
+        << settings_.tolerance * forceScale
         << "): below the round-off of this discretisation, or the preconditioner is poor";
     why = msg.str();
     return false;
@@ -285,8 +323,10 @@ bool NewtonSolver<D>::solveAt(double t, std::string& why) {
   solver_.beginStaticStep(t);
   loadTime_ = t;
   Eigen::VectorXd r, du, rTrial;
+  history_.clear();
   for (int it = 0; it < settings_.maxIterations; ++it) {
     const double ratio = solver_.residualRatio();
+    history_.push_back(ratio);
     if (!std::isfinite(ratio)) {
       why = "the residual is not finite (an inverted particle?)";
       return false;

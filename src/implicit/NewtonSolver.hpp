@@ -4,6 +4,8 @@
 // with K the exact tangent (TangentStiffness::apply) and the linear system solved by conjugate
 // gradients preconditioned with the factorised assembled matrix (exact when the hourglass
 // penalty is off, so one iteration; with the penalty it bounds the penalty's part from above).
+// A following pressure adds its load stiffness (FollowingPressure.hpp), which is not
+// symmetric: such a scene's system is solved by BiCGSTAB with the same preconditioner.
 // The step length s comes from a backtracking line search on |r|. A load step that does not
 // converge is halved; the scene is left at the last converged state when the solve fails.
 #pragma once
@@ -109,6 +111,9 @@ class NewtonSolver {
   ~NewtonSolver();
 
   const NewtonStatistics& statistics() const { return statistics_; }
+  // The out-of-balance ratios (Solver::residualRatio) of the last load step tried, one per
+  // iteration and the last one's result: the convergence rate, for tests and studies.
+  const std::vector<double>& residualHistory() const { return history_; }
   const DofMap<D>& dofs() const { return dofs_; }
   TangentStiffness<D>& tangent() { return tangent_; }
 
@@ -142,8 +147,13 @@ class NewtonSolver {
   Eigen::VectorXd precondition(const Eigen::VectorXd& r) {
     return multigrid_ ? multigrid_->apply(r) : factor_.solve(r);
   }
-  // Preconditioned conjugate gradients on the exact K; false on negative curvature.
+  // Preconditioned conjugate gradients on the exact K (BiCGSTAB with a following pressure);
+  // false on negative curvature, a breakdown or a stall.
   bool solveLinear(const Eigen::VectorXd& r, Eigen::VectorXd& du, std::string& why);
+  // The exact K on v: the strain and penalty parts, and the following pressures' stiffness.
+  void applyTangent(const Eigen::VectorXd& v, Eigen::VectorXd& Kv);
+  // The Krylov method's name for the statistics.
+  const char* krylovName() const { return following_ ? "BiCGSTAB" : "conjugate gradients"; }
   bool solveAt(double t, std::string& why);
 
   Scene<D>& scene_;
@@ -171,6 +181,11 @@ class NewtonSolver {
   double factorTime_ = 0.0, loadTime_ = 0.0;
   std::vector<Vec<D>> factorDisplacement_;
   std::vector<typename TaylorQuadrature<D>::SymMatrix> factorSecondGradients_;
+  std::vector<double> history_;
+  // Some load is a following pressure: the tangent is not symmetric.
+  bool following_ = false;
+  std::vector<Vec<D>> variation_, loadProduct_;  // per particle, for applyTangent
+  Eigen::VectorXd loadStiffness_;
 };
 
 extern template class NewtonSolver<2>;

@@ -3,9 +3,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "model/FollowingPressure.hpp"
 #include "model/Types.hpp"
 
 namespace tlsph {
@@ -79,13 +81,16 @@ struct Prescription {
 };
 
 // Neumann condition: a force per particle at full value (a traction already multiplied by
-// the particle's area, or a total force already shared out), scaled by the ramp.
+// the particle's area, or a total force already shared out), scaled by the ramp. A following
+// pressure's force depends on the present shape: `following` computes it, and `force` holds
+// the dead pressure's, its size at the reference configuration (for diagnostics).
 template <int D>
 struct Load {
   std::string name;
   std::vector<Index> particles;
   std::vector<Vec<D>> force;
   Ramp ramp;
+  std::optional<FollowingPressure<D>> following;
 };
 
 // A ghost of a mirrored clamp (docs/method.md section 3). Its displacement extrapolates the body's

@@ -56,8 +56,19 @@ void Builder<D>::readLoads() {
     const std::string type = r.word("type", std::nullopt, {"traction", "force", "pressure"});
     Vec<D> value = Vec<D>::Zero();
     double pressure = 0.0;
+    bool follow = false;
     if (type == "pressure") {
       pressure = r.number("value");
+      // A following pressure acts on the present shape of the surface's facets, which only a
+      // named surface of a mesh body has.
+      follow = r.flag("follow", false);
+      if (follow && !surface)
+        throw r.error(
+            "follow",
+            "a following pressure acts on a named surface of a mesh body (surface = "
+            "NAME), whose facets it follows as they move; " +
+                (faceName.empty() ? std::string("this load has none")
+                                  : "face " + faceName + " of the bounding box has none"));
       // Pressure pushes against the outward normal: it needs the surface's normals and areas,
       // which a named surface has and a lattice face has exactly (dx^(d-1) per particle).
       if (!surface && (faceName.empty() || setup_.freeForm))
@@ -67,6 +78,9 @@ void Builder<D>::readLoads() {
                                   : "pressure acts on a face of the bodies' bounding box (face "
                                     "= x-, ...) or on a named surface of a mesh body");
     } else {
+      if (r.has("follow"))
+        throw r.error("follow",
+                      "only a pressure follows the surface (type = pressure), not a " + type);
       value = r.vector<D>("value");
     }
     load.ramp.duration = r.nonNegative("ramp", 0.0);
@@ -97,8 +111,16 @@ void Builder<D>::readLoads() {
         load.force.push_back(share * value);
       }
     }
+    if (follow) {
+      load.following.emplace(surface->facets, pressure);
+      if (setup_.followingLoad.empty()) {
+        setup_.followingLoad = load.name;
+        setup_.followingWhere = config_.where(load.name, "follow");
+      }
+    }
     if (type == "pressure") {
-      setup_.conditions.push_back(load.name + ": pressure " + fmt(pressure) + " Pa on " +
+      setup_.conditions.push_back(load.name + ": " + (follow ? "following " : "") + "pressure " +
+                                  fmt(pressure) + " Pa on " +
                                   std::to_string(load.particles.size()) + " particles" + where);
       setup_.scene.loads.push_back(std::move(load));
       continue;

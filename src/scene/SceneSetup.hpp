@@ -92,6 +92,9 @@ struct SceneSetup {
   // Whether the scene can be rebuilt at a coarser dx (the Newton solver's multigrid levels): not
   // a particle file, nor a mesh at a size of its own.
   bool coarsenable = true;
+  // The first following pressure's section and the place of its `follow` key (a distributed
+  // run refuses it); empty when the scene has none.
+  std::string followingLoad, followingWhere;
   std::vector<std::string> conditions;  // one line per condition, for `tlsph check`
   std::vector<std::string> warnings;    // scene problems that do not stop a run
 };

@@ -196,6 +196,25 @@ TEST_F(CheckpointRestart, NewtonMultigridContinuesBitForBit) {
                  randomStep(1, 2), 2);
 }
 
+// A following pressure is evaluated on the restored displacements: the Lame ring in rubber
+// under a following pressure in its bore, undamped, and solved by Newton in load steps.
+TEST_F(CheckpointRestart, FollowingPressureDynamicContinuesBitForBit) {
+  restartMatches(scene("validation/scenes/lame_ring.ini") +
+                     " --scene.dx=0.0125 --load.p.follow=true --load.p.value=1e5"
+                     " --material.steel.model=neo-hookean --material.steel.youngs_modulus=1e6"
+                     " --material.steel.density=1000 --static.enabled=false --time.end=0.02"
+                     " --damping.kinetic=false --output.every_time=0.005",
+                 randomStep(20, 80));
+}
+
+TEST_F(CheckpointRestart, FollowingPressureNewtonContinuesBitForBit) {
+  restartMatches(scene("validation/scenes/lame_ring.ini") +
+                     " --scene.dx=0.0125 --load.p.follow=true --load.p.value=1e5 --load.p.ramp=1"
+                     " --material.steel.model=neo-hookean --material.steel.youngs_modulus=1e6"
+                     " --material.steel.density=1000 --static.load_steps=3",
+                 1);
+}
+
 // SIGTERM at a random moment once the run has begun (its first series written): exit 143 with a
 // checkpoint; restarting from it ('latest') ends exactly where the uninterrupted run ends.
 TEST_F(CheckpointRestart, TerminatedRunRestartsFromItsCheckpoint) {

@@ -428,6 +428,20 @@ def main():
             f"exit status {rc1} / {rcn}:\n{log1}\n{logn}"]
         failures += report("set-up error", problems, ok="same")
 
+        # A following pressure reads the corners of its facets, which a rank may not hold: a
+        # distributed run refuses it, naming the key.
+        if RANKS > 1:
+            with open(os.path.join(work, "strip_top.geo"), "w") as f:
+                f.write(FILES["strip.geo"] + 'Physical Curve("top") = {3};\n')
+            follow = os.path.join(work, "follow.ini")
+            with open(follow, "w") as f:
+                f.write(SCENES["mesh2d"].replace("file = strip.geo", "file = strip_top.geo") +
+                        "[load.p]\nsurface = top\ntype = pressure\nvalue = 100\nfollow = true\n")
+            rc, log = run(follow, os.path.join(work, "follow_n"), RANKS)
+            expected = "[load.p] follow: a following pressure runs on one rank only"
+            problems = [] if rc == 1 and expected in log else [f"exit status {rc}:\n{log}"]
+            failures += report("following pressure", problems, ok="refused")
+
         # Pieces that cannot be written (a file where the first frame's directory of pieces
         # goes): every rank stops with exit 6 and the lowest failing rank's reason.
         if RANKS > 1:
