@@ -148,4 +148,35 @@ inline std::string clampedBeamText(double length, const std::string& model = "ne
          std::to_string(length) + " 0.05 0.05\n[clamp.root]\nface = x-\n[time]\nend = 1\n" + extra;
 }
 
+// A block of counts particles at spacing dx, moved by up to jitter dx, with the quadratic
+// correction and (taylor) the Taylor quadrature: the Taylor term's tests' body.
+template <int D>
+Scene<D> taylorBlockScene(const std::string& material, double alpha, double jitter,
+                          std::mt19937& rng, double dx, bool taylor = true) {
+  std::array<int, D> counts;
+  counts.fill(D == 2 ? 6 : 4);
+  counts[0] = D == 2 ? 8 : 5;
+  auto X = perturbedBlock<D>(counts, dx, jitter, rng);
+  Scene<D> scene = sceneOf<D>(X, dx, 2.4, testMaterial(material), alpha);
+  scene.gradientCorrection = GradientCorrection::Quadratic;
+  scene.quadrature = taylor ? Quadrature::Taylor : Quadrature::Nodal;
+  return scene;
+}
+
+// Random quadrature moments: mu up to 0.3 dx per axis, N = mu mu^T + a positive definite
+// central part of about a lattice cell's size.
+template <int D>
+void addRandomMoments(Scene<D>& scene, std::mt19937& rng, double dx) {
+  auto& p = scene.particles;
+  p.quadratureOffset.resize(p.size());
+  p.quadratureSpread.resize(p.size());
+  for (Index i = 0; i < p.size(); ++i) {
+    const Vec<D> mu = randomVector<D>(rng, 0.3 * dx);
+    const Mat<D> B = randomMatrix<D>(rng, 0.15 * dx);
+    p.quadratureOffset[i] = mu;
+    p.quadratureSpread[i] =
+        mu * mu.transpose() + B * B.transpose() + (dx * dx / 48.0) * Mat<D>::Identity();
+  }
+}
+
 }  // namespace tlsph::testing

@@ -45,6 +45,7 @@
 #include "fast/SharedRows.hpp"
 #include "materials/Material.hpp"
 #include "method/ReferenceConfiguration.hpp"
+#include "method/TaylorCorrection.hpp"
 #include "model/QuadratureMoments.hpp"
 #include "model/Types.hpp"
 
@@ -488,36 +489,12 @@ class TaylorQuadrature {
     }
     return volume_[i] * e;
   }
-  // dP^q and dR_a (method/TaylorCorrection::linearised).
-  struct GeneralLinearised {
-    Mat<D> stress;
-    Gradients hyperstress;
-  };
-  GeneralLinearised generalLinearised(Index i, const Mat<D>& F, const Gradients& G,
-                                      const Mat<D>& dH, const Gradients& dG) const {
-    const bool small = smallStrain_[i];
+  // dP^q and dR_a: the plain term's formula (method/TaylorCorrection.hpp).
+  TaylorLinearised<D> generalLinearised(Index i, const Mat<D>& F, const Gradients& G,
+                                        const Mat<D>& dH, const Gradients& dG) const {
     const GeneralStresses t = generalStresses(i, F, G);
-    Gradients ds;  // C0 : de_a
-    for (int a = 0; a < D; ++a)
-      ds[a] = stressOf(i, small ? dG[a] : Mat<D>(dH.transpose() * G[a] + F.transpose() * dG[a]));
-    const Mat<D> dS = stressOf(i, small ? dH : Mat<D>(F.transpose() * dH));  // C0 : dE
-    Mat<D> dtau = Mat<D>::Zero();
-    for (int a = 0; a < D; ++a)
-      dtau += offset_[i][a] * ds[a];
-    GeneralLinearised d;
-    d.stress = small ? dtau : Mat<D>(dH * t.tau + F * dtau);
-    for (int a = 0; a < D; ++a) {
-      Mat<D> dsigma = offset_[i][a] * dS;
-      for (int b = 0; b < D; ++b)
-        dsigma += spread_[i](a, b) * ds[b];
-      if (small) {
-        d.hyperstress[a] = dsigma;
-      } else {
-        d.stress += dG[a] * t.sigma[a] + G[a] * dsigma;
-        d.hyperstress[a] = dH * t.sigma[a] + F * dsigma;
-      }
-    }
-    return d;
+    return linearisedTaylorTerm<D>(offset_[i], spread_[i], lambda_[i], mu_[i], smallStrain_[i], F,
+                                   G, t.sigma, t.tau, dH, dG);
   }
 
   // The linear-elastic material's hyperstress, e_a = sym(G_a): no P^q.

@@ -67,6 +67,54 @@ template <int D>
 std::vector<Mat<D>> fitSecondDerivatives(const ReferenceConfiguration<D>& ref,
                                          const std::vector<double>& volume, Index i);
 
+// The linearisation of one particle's P^q and R_a (TaylorCorrection::stress and hyperstress)
+// about (F, G) in a direction whose displacement gradient is dH and second gradients dG, given
+// the particle's constants (mu, N, lambda, mu_lame, small: linear-elastic) and its sigma_a and
+// tau at (F, G); the plain term and the fast pass (fast/TaylorQuadrature.hpp) both call it.
+// With de_a = sym(dH^T G_a + F^T dG_a) and dE = sym(F^T dH) (sym(dG_a) and sym(dH) for the
+// linear-elastic material),
+//   dsigma_a = sum_b N_ab C0 : de_b + mu_a C0 : dE,   dtau = sum_a mu_a C0 : de_a,
+//   dP^q = sum_a (dG_a sigma_a + G_a dsigma_a) + dH tau + F dtau,   dR_a = dH sigma_a + F
+//   dsigma_a
+// (dP^q = dtau and dR_a = dsigma_a for the linear-elastic material).
+template <int D>
+struct TaylorLinearised {
+  Mat<D> stress;
+  std::array<Mat<D>, D> hyperstress;
+};
+template <int D>
+TaylorLinearised<D> linearisedTaylorTerm(const Vec<D>& offset, const Mat<D>& spread, double lambda,
+                                         double mu, bool small, const Mat<D>& F,
+                                         const std::array<Mat<D>, D>& G,
+                                         const std::array<Mat<D>, D>& sigma, const Mat<D>& tau,
+                                         const Mat<D>& dH, const std::array<Mat<D>, D>& dG) {
+  auto C0 = [&](const Mat<D>& A) -> Mat<D> {  // C0 : sym(A)
+    const Mat<D> e = 0.5 * (A + A.transpose());
+    return lambda * e.trace() * Mat<D>::Identity() + 2.0 * mu * e;
+  };
+  std::array<Mat<D>, D> ds;  // C0 : de_a
+  for (int a = 0; a < D; ++a)
+    ds[a] = C0(small ? dG[a] : Mat<D>(dH.transpose() * G[a] + F.transpose() * dG[a]));
+  const Mat<D> dS = C0(small ? dH : Mat<D>(F.transpose() * dH));  // C0 : dE
+  Mat<D> dtau = Mat<D>::Zero();
+  for (int a = 0; a < D; ++a)
+    dtau += offset[a] * ds[a];
+  TaylorLinearised<D> d;
+  d.stress = small ? dtau : Mat<D>(dH * tau + F * dtau);
+  for (int a = 0; a < D; ++a) {
+    Mat<D> dsigma = offset[a] * dS;
+    for (int b = 0; b < D; ++b)
+      dsigma += spread(a, b) * ds[b];
+    if (small) {
+      d.hyperstress[a] = dsigma;
+    } else {
+      d.stress += dG[a] * sigma[a] + G[a] * dsigma;
+      d.hyperstress[a] = dH * sigma[a] + F * dsigma;
+    }
+  }
+  return d;
+}
+
 template <int D>
 class TaylorCorrection {
  public:
@@ -176,45 +224,13 @@ class TaylorCorrection {
   }
 
   // The linearisation of stress() and hyperstress() about (F, G) in a direction whose
-  // displacement gradient is dH and second gradients dG (the tangent stiffness's part of the
-  // term): with de_a = sym(dH^T G_a + F^T dG_a) and dE = sym(F^T dH) (sym(dG_a) and sym(dH)
-  // for the linear-elastic material),
-  //   dsigma_a = sum_b N_ab C0 : de_b + mu_a C0 : dE,   dtau = sum_a mu_a C0 : de_a,
-  //   dP^q = sum_a (dG_a sigma_a + G_a dsigma_a) + dH tau + F dtau,   dR_a = dH sigma_a + F
-  //   dsigma_a
-  // (dP^q = dtau and dR_a = dsigma_a for the linear-elastic material).
-  struct Linearised {
-    Mat<D> stress;
-    Gradients hyperstress;
-  };
+  // displacement gradient is dH and second gradients dG (linearisedTaylorTerm above).
+  using Linearised = TaylorLinearised<D>;
   Linearised linearised(Index i, const Mat<D>& F, const Gradients& G, const Mat<D>& dH,
                         const Gradients& dG) const {
-    const bool small = smallStrain_[i];
     const Stresses t = stresses(i, F, G);
-    Gradients ds;  // C0 : de_a
-    for (int a = 0; a < D; ++a) {
-      const Mat<D> A = small ? dG[a] : Mat<D>(dH.transpose() * G[a] + F.transpose() * dG[a]);
-      ds[a] = smallStrainStress(i, 0.5 * (A + A.transpose()));
-    }
-    const Mat<D> B = small ? dH : Mat<D>(F.transpose() * dH);
-    const Mat<D> dS = smallStrainStress(i, 0.5 * (B + B.transpose()));  // C0 : dE
-    Linearised d;
-    Mat<D> dtau = Mat<D>::Zero();
-    for (int a = 0; a < D; ++a)
-      dtau += offset_[i][a] * ds[a];
-    d.stress = small ? dtau : Mat<D>(dH * t.tau + F * dtau);
-    for (int a = 0; a < D; ++a) {
-      Mat<D> dsigma = offset_[i][a] * dS;
-      for (int b = 0; b < D; ++b)
-        dsigma += spread_[i](a, b) * ds[b];
-      if (small) {
-        d.hyperstress[a] = dsigma;
-      } else {
-        d.stress += dG[a] * t.sigma[a] + G[a] * dsigma;
-        d.hyperstress[a] = dH * t.sigma[a] + F * dsigma;
-      }
-    }
-    return d;
+    return linearisedTaylorTerm<D>(offset_[i], spread_[i], lambda_[i], mu_[i], smallStrain_[i], F,
+                                   G, t.sigma, t.tau, dH, dG);
   }
 
   // f -= the part of dE_q/du through G: each pair sends V_I sum_a R_Ia S_IJ(:, a) to J and

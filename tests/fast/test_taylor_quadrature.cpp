@@ -28,29 +28,7 @@ constexpr double kDx = 0.01;
 template <int D>
 Scene<D> blockScene(const std::string& material, double alpha, double jitter, std::mt19937& rng,
                     bool taylor = true) {
-  std::array<int, D> counts;
-  counts.fill(D == 2 ? 6 : 4);
-  counts[0] = D == 2 ? 8 : 5;
-  auto X = perturbedBlock<D>(counts, kDx, jitter, rng);
-  Scene<D> scene = sceneOf<D>(X, kDx, 2.4, testMaterial(material), alpha);
-  scene.gradientCorrection = GradientCorrection::Quadratic;
-  scene.quadrature = taylor ? Quadrature::Taylor : Quadrature::Nodal;
-  return scene;
-}
-
-// Random moments: mu up to 0.3 dx per axis, N = mu mu^T + a positive definite central part.
-template <int D>
-void addRandomMoments(Scene<D>& scene, std::mt19937& rng) {
-  auto& p = scene.particles;
-  p.quadratureOffset.resize(p.size());
-  p.quadratureSpread.resize(p.size());
-  for (Index i = 0; i < p.size(); ++i) {
-    const Vec<D> mu = randomVector<D>(rng, 0.3 * kDx);
-    const Mat<D> B = randomMatrix<D>(rng, 0.15 * kDx);
-    p.quadratureOffset[i] = mu;
-    p.quadratureSpread[i] =
-        mu * mu.transpose() + B * B.transpose() + (kDx * kDx / 48.0) * Mat<D>::Identity();
-  }
+  return taylorBlockScene<D>(material, alpha, jitter, rng, kDx, taylor);
 }
 
 template <int D>
@@ -58,7 +36,7 @@ void expectForceIsMinusEnergyGradient(const std::string& material, double alpha,
                                       bool moments = false) {
   std::mt19937 rng(seed);
   Scene<D> scene = blockScene<D>(material, alpha, 0.15, rng);
-  if (moments) addRandomMoments<D>(scene, rng);
+  if (moments) addRandomMoments<D>(scene, rng, kDx);
   ForceEvaluator<D> eval(scene);
   ASSERT_NE(eval.forces().quadrature(), nullptr);
   const Index n = eval.size();
@@ -110,7 +88,7 @@ template <int D>
 void expectPlainWithMoments(const std::string& material, std::uint32_t seed) {
   std::mt19937 rng(seed);
   Scene<D> scene = blockScene<D>(material, 10.0, 0.15, rng);
-  addRandomMoments<D>(scene, rng);
+  addRandomMoments<D>(scene, rng, kDx);
   ForceEvaluator<D> fast(scene);
   ForceEvaluator<D, PairForces<D>> plain(scene);
   const Index n = fast.size();
@@ -190,7 +168,7 @@ void expectTangentIsForceDifference(double alpha, std::uint32_t seed, bool momen
                                     const std::string& material = "neo-hookean") {
   std::mt19937 rng(seed);
   Scene<D> scene = blockScene<D>(material, alpha, 0.15, rng);
-  if (moments) addRandomMoments<D>(scene, rng);
+  if (moments) addRandomMoments<D>(scene, rng, kDx);
   auto& p = scene.particles;
   // hold the first layer
   Prescription<D> clamp;

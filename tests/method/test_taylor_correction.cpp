@@ -24,36 +24,13 @@ constexpr double kDx = 0.01;
 template <int D>
 Scene<D> blockScene(const std::string& material, double alpha, double jitter, std::mt19937& rng,
                     bool taylor = true) {
-  std::array<int, D> counts;
-  counts.fill(D == 2 ? 6 : 4);
-  counts[0] = D == 2 ? 8 : 5;
-  auto X = perturbedBlock<D>(counts, kDx, jitter, rng);
-  Scene<D> scene = sceneOf<D>(X, kDx, 2.4, testMaterial(material), alpha);
-  scene.gradientCorrection = GradientCorrection::Quadratic;
-  scene.quadrature = taylor ? Quadrature::Taylor : Quadrature::Nodal;
-  return scene;
-}
-
-// Random moments: mu up to 0.3 dx per axis, N = mu mu^T + a positive definite central part of
-// about the lattice cell's size.
-template <int D>
-void addRandomMoments(Scene<D>& scene, std::mt19937& rng) {
-  auto& p = scene.particles;
-  p.quadratureOffset.resize(p.size());
-  p.quadratureSpread.resize(p.size());
-  for (Index i = 0; i < p.size(); ++i) {
-    const Vec<D> mu = randomVector<D>(rng, 0.3 * kDx);
-    const Mat<D> B = randomMatrix<D>(rng, 0.15 * kDx);
-    p.quadratureOffset[i] = mu;
-    p.quadratureSpread[i] =
-        mu * mu.transpose() + B * B.transpose() + (kDx * kDx / 48.0) * Mat<D>::Identity();
-  }
+  return taylorBlockScene<D>(material, alpha, jitter, rng, kDx, taylor);
 }
 
 template <int D>
 Scene<D> momentScene(const std::string& material, double alpha, std::mt19937& rng) {
   Scene<D> scene = blockScene<D>(material, alpha, 0.15, rng);
-  addRandomMoments<D>(scene, rng);
+  addRandomMoments<D>(scene, rng, kDx);
   return scene;
 }
 
