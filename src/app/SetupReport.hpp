@@ -36,7 +36,9 @@ void printSetup(const SceneSetup<D>& setup, const Solver<D>& solver) {
   if (const auto& ic = solver.integrationConstraint(); ic.applied)
     std::cout << "integration  gradient vectors corrected for the boundary's area vectors: defect "
               << ic.defectBefore << " -> " << ic.defectAfter << " of the largest a_I ("
-              << ic.iterations << " CG iterations)\n";
+              << ic.iterations << " CG iterations, "
+              << (ic.factorised ? "Cholesky-preconditioned" : "Jacobi-preconditioned") << ", "
+              << ic.seconds << " s)\n";
   std::cout << "hourglass    alpha = " << setup.scene.hourglassCoefficient
             << (setup.scene.hourglassCoefficient == 0
                     ? std::string(" (off)")

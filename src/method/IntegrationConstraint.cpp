@@ -1,13 +1,14 @@
 // The integration constraint's correction of the gradient vectors (IntegrationConstraint.hpp),
-// compiled once for 2D and 3D: a set-up cost, one conjugate-gradient solve per body.
+// compiled once for 2D and 3D: a set-up cost, one preconditioned conjugate-gradient solve per body.
 #include "method/IntegrationConstraint.hpp"
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
-#include <sstream>
 
+#include "implicit/SparseCholesky.hpp"
 #include "method/TaylorCorrection.hpp"
 #include "model/Errors.hpp"
 
@@ -52,6 +53,9 @@ namespace {
 // iterations run out (the best iterate is kept).
 constexpr double kIntegrationTolerance = 1e-6;
 constexpr int kIntegrationIterations = 3000;
+// The preconditioner's shift, relative to the diagonal: it must keep the factorisation of the
+// semi-definite matrix (null space: the polynomial lambda) safe from rounding.
+constexpr double kIntegrationShift = 1e-9;
 
 // Per particle K: the W-orthogonal projector onto the pair values that the fit's monomials
 // annihilate, Pi_K y = W y - W P^T M^{-1} P W y, kept as the scaled monomials of each pair and
@@ -130,6 +134,116 @@ PairArray<Index> reversePairIndex(const NeighbourList& nb) {
   return rev;
 }
 
+// The matrix of A Pi A^T for one component (it is the same for every component), its lower
+// triangle. Particle K's block couples K with its neighbours: the pair values y_KJ =
+// V_K (lambda_J - lambda_K) are V_K C (lambda_J..., lambda_K) with C = [I | -1], so the block is
+// V_K^2 C^T Pi_K C: Pi_K(J, J') between neighbours, minus its row sums s_J between a neighbour
+// and K, and sum_J s_J on K's diagonal.
+template <int D>
+SparseCholesky::Matrix constraintMatrix(const NeighbourList& nb, const Projectors<D>& projector,
+                                        const std::vector<double>& volume) {
+  using Basis = typename Projectors<D>::Basis;
+  const Index n = nb.particleCount();
+  // Column j's rows (>= j): every particle sharing a block with j, i.e. in the list of j or of
+  // one of j's neighbours (the lists are symmetric).
+  std::vector<int> start(n + 1, 0);
+  std::vector<std::vector<int>> rows(n);
+#pragma omp parallel
+  {
+    std::vector<std::uint8_t> seen(n, 0);
+#pragma omp for schedule(dynamic, 64)
+    for (Index j = 0; j < n; ++j) {
+      auto& r = rows[j];
+      auto add = [&](Index i) {
+        if (i >= j && !seen[i]) {
+          seen[i] = 1;
+          r.push_back(i);
+        }
+      };
+      auto block = [&](Index K) {
+        add(K);
+        for (Index k = nb.offset[K]; k < nb.offset[K + 1]; ++k)
+          add(nb.neighbour[k]);
+      };
+      block(j);
+      for (Index k = nb.offset[j]; k < nb.offset[j + 1]; ++k)
+        block(nb.neighbour[k]);
+      for (Index i : r)
+        seen[i] = 0;
+      std::sort(r.begin(), r.end());
+    }
+  }
+  for (Index j = 0; j < n; ++j)
+    start[j + 1] = start[j] + int(rows[j].size());
+  std::vector<int> inner(start[n]);
+  for (Index j = 0; j < n; ++j) {
+    std::copy(rows[j].begin(), rows[j].end(), inner.begin() + start[j]);
+    std::vector<int>().swap(rows[j]);
+  }
+  std::vector<double> value(start[n], 0.0);
+  auto entry = [&](Index a, Index b) -> double& {
+    const Index col = std::min(a, b), row = std::max(a, b);
+    const auto first = inner.begin() + start[col], last = inner.begin() + start[col + 1];
+    return value[std::lower_bound(first, last, row) - inner.begin()];
+  };
+
+#pragma omp parallel
+  {
+    std::vector<Basis> q;
+    std::vector<double> rowSum;
+#pragma omp for schedule(dynamic, 16)
+    for (Index K = 0; K < n; ++K) {
+      const Index first = nb.offset[K], count = nb.count(K);
+      if (count == 0) continue;
+      const auto& Minv = projector.inverse[K];
+      q.resize(count);
+      rowSum.resize(count);
+      Basis sigma = Basis::Zero();
+      for (Index a = 0; a < count; ++a) {
+        q[a] = Minv * projector.basis[first + a];
+        sigma += projector.weight[first + a] * projector.basis[first + a];
+      }
+      const double scale = volume[K] * volume[K];
+      double own = 0.0;
+      for (Index a = 0; a < count; ++a) {
+        const double wa = projector.weight[first + a];
+        rowSum[a] = wa - wa * q[a].dot(sigma);
+        own += rowSum[a];
+        const Index J = nb.neighbour[first + a];
+        for (Index b = 0; b <= a; ++b) {
+          const Index L = nb.neighbour[first + b];
+          double pi = -wa * projector.weight[first + b] * q[a].dot(projector.basis[first + b]);
+          if (a == b) pi += wa;
+          double& e = entry(J, L);
+#pragma omp atomic
+          e += scale * pi;
+        }
+        double& coupling = entry(J, K);
+#pragma omp atomic
+        coupling -= scale * rowSum[a];
+      }
+      double& diagonal = entry(K, K);
+#pragma omp atomic
+      diagonal += scale * own;
+    }
+  }
+  return SparseCholesky::Matrix(Eigen::Map<const SparseCholesky::Matrix>(
+      n, n, start[n], start.data(), inner.data(), value.data()));
+}
+
+// After the gradient vectors changed: their per-particle sums and the reverse vectors.
+template <int D>
+void refreshGradientSums(ReferenceConfiguration<D>& ref, const std::vector<double>& volume) {
+  const auto& nb = ref.neighbours;
+  for (Index i = 0; i < ref.particleCount(); ++i) {
+    Vec<D> G = Vec<D>::Zero();
+    for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k)
+      G += ref.correctedGradient[k];
+    ref.correctedGradientSum[i] = G;
+  }
+  ref.reverseGradient = reverseVectors<D>(nb, ref.correctedGradient, volume, ref.rows());
+}
+
 }  // namespace
 
 template <int D>
@@ -164,6 +278,7 @@ void enforceIntegrationConstraint(ReferenceConfiguration<D>& ref, const std::vec
     throw SetupError("the body's boundary is not closed: its area vectors sum to " +
                      std::to_string(total.norm()) + ", the largest is " + std::to_string(scale));
 
+  const auto started = std::chrono::steady_clock::now();
   IntegrationConstraintSummary& summary = ref.integrationConstraint;
   summary = {};
   summary.applied = true;
@@ -191,26 +306,6 @@ void enforceIntegrationConstraint(ReferenceConfiguration<D>& ref, const std::vec
       r.template segment<D>(D * i) = s;
     }
   };
-  // Jacobi: the diagonal of A Pi A^T, from each particle's block: the column of lambda_K in
-  // its own pairs is -V_K (1, ..., 1), that of a neighbour J's is V_K e_J.
-  Eigen::VectorXd diagonal = Eigen::VectorXd::Zero(D * n);
-  for (Index i = 0; i < n; ++i) {
-    typename Projectors<D>::Basis sum = Projectors<D>::Basis::Zero();
-    double weights = 0.0;
-    for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
-      const auto& p = projector.basis[k];
-      const double w = projector.weight[k];
-      const double own = w - w * w * p.dot(projector.inverse[i] * p);  // Pi_K(J, J)
-      diagonal.template segment<D>(D * nb.neighbour[k]).array() += volume[i] * volume[i] * own;
-      sum += w * p;
-      weights += w;
-    }
-    diagonal.template segment<D>(D * i).array() +=
-        volume[i] * volume[i] * (weights - sum.dot(projector.inverse[i] * sum));
-  }
-  for (Index q = 0; q < D * n; ++q)
-    if (!(diagonal[q] > 0.0)) diagonal[q] = 1.0;
-
   // A Pi A^T annihilates every lambda that is a quadratic (linear on the linear correction)
   // polynomial of X: its differences are what Pi projects out. The defect's part along those
   // fields cannot be corrected; it is the quadrature error of int grad q dV against the
@@ -241,17 +336,44 @@ void enforceIntegrationConstraint(ReferenceConfiguration<D>& ref, const std::vec
         b[D * i + a] = ca[i];
     }
   }
-  // Jacobi-preconditioned conjugate gradients, keeping the iterate of the smallest residual:
-  // the operator is of high order in the smooth fields (Pi removes their differences up to the
-  // quadratic), so the last, smooth part of the defect converges slowly and its residual is not
-  // monotone; that part is O(h^3) small.
-  const int maxIterations = kIntegrationIterations;
+  // Conjugate gradients preconditioned by a Cholesky factor of B + eps diag(B), B the operator's
+  // matrix for one component (the same for each): the operator is of high order in the smooth
+  // fields (Pi removes their differences up to the quadratic), so a diagonal preconditioner
+  // leaves the smooth part of the defect to thousands of iterations, while the factor of the
+  // slightly shifted matrix leaves only its few eigenvalues below eps, a handful of iterations.
+  // The best iterate is kept (the residual of a semi-definite system need not fall monotonely).
+  const SparseCholesky::Matrix B = constraintMatrix<D>(nb, projector, volume);
+  const Eigen::VectorXd diagonal = B.diagonal();
+  SparseCholesky factor;
+  {
+    SparseCholesky::Matrix shifted = B;
+    for (Index i = 0; i < n; ++i)
+      shifted.coeffRef(i, i) += kIntegrationShift * std::max(diagonal[i], 0.0);
+    summary.factorised = factor.factorise(shifted);
+  }
+  auto precondition = [&](const Eigen::VectorXd& r) {
+    Eigen::VectorXd z(D * n);
+    if (!summary.factorised) {
+      for (Index q = 0; q < D * n; ++q)
+        z[q] = diagonal[q / D] > 0.0 ? r[q] / diagonal[q / D] : r[q];
+      return z;
+    }
+    Eigen::VectorXd component(n);
+    for (int a = 0; a < D; ++a) {
+      for (Index i = 0; i < n; ++i)
+        component[i] = r[D * i + a];
+      const Eigen::VectorXd solved = factor.solve(component);
+      for (Index i = 0; i < n; ++i)
+        z[D * i + a] = solved[i];
+    }
+    return z;
+  };
   Eigen::VectorXd r = b, best = lambda, Ap(D * n);
-  Eigen::VectorXd zr = r.cwiseQuotient(diagonal), p = zr;
+  Eigen::VectorXd zr = precondition(r), p = zr;
   double rz = r.dot(zr), bestResidual = r.norm();
   const double target = kIntegrationTolerance * b.norm();
   int it = 0;
-  for (; it < maxIterations && bestResidual > target; ++it) {
+  for (; it < kIntegrationIterations && bestResidual > target; ++it) {
     spread(p);
     gather(Ap);
     const double curvature = p.dot(Ap);
@@ -263,7 +385,7 @@ void enforceIntegrationConstraint(ReferenceConfiguration<D>& ref, const std::vec
       bestResidual = r.norm();
       best = lambda;
     }
-    zr = r.cwiseQuotient(diagonal);
+    zr = precondition(r);
     const double rzNew = r.dot(zr);
     p = zr + (rzNew / rz) * p;
     rz = rzNew;
@@ -274,16 +396,12 @@ void enforceIntegrationConstraint(ReferenceConfiguration<D>& ref, const std::vec
   spread(lambda);
   for (Index k = 0; k < nb.pairCount(); ++k)
     ref.correctedGradient[k] += z[k];
-  for (Index i = 0; i < n; ++i) {
-    Vec<D> G = Vec<D>::Zero();
-    for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k)
-      G += ref.correctedGradient[k];
-    ref.correctedGradientSum[i] = G;
-  }
-  ref.reverseGradient = reverseVectors<D>(nb, ref.correctedGradient, volume, ref.rows());
+  refreshGradientSums<D>(ref, volume);
 
   for (const auto& ci : defect())
     summary.defectAfter = std::max(summary.defectAfter, ci.norm() / scale);
+  summary.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
 }
 
 template <int D>
@@ -309,15 +427,10 @@ ReferenceConfiguration<D> buildSceneReference(const std::vector<Vec<D>>& X,
   ReferenceConfiguration<D> part = build(rows);
   const auto& wn = whole.neighbours;
   const auto& pn = part.neighbours;
-  for (Index i : *rows) {
-    Vec<D> G = Vec<D>::Zero();
-    for (Index k = 0; k < pn.count(i); ++k) {
+  for (Index i : *rows)
+    for (Index k = 0; k < pn.count(i); ++k)
       part.correctedGradient[pn.offset[i] + k] = whole.correctedGradient[wn.offset[i] + k];
-      G += part.correctedGradient[pn.offset[i] + k];
-    }
-    part.correctedGradientSum[i] = G;
-  }
-  part.reverseGradient = reverseVectors<D>(pn, part.correctedGradient, volume, part.rows());
+  refreshGradientSums<D>(part, volume);
   part.integrationConstraint = whole.integrationConstraint;
   return part;
 }

@@ -23,11 +23,12 @@
 //   Pi_K = W_K - W_K P_K^T M_K^{-1} P_K W_K   (M_K = P_K W_K P_K^T, the fit's moment matrix),
 // the minimiser is delta_K = Pi_K (A^T lambda)_K with (A^T lambda)_KJ = V_K (lambda_J - lambda_K),
 // and lambda solves A Pi A^T lambda = a - d (one system per component, solved together by
-// conjugate gradients; lambda polynomial up to the fit's order is its null space, and the
-// defect's part along it is the O(h^2) quadrature error that no such delta can remove). F stays the
-// gradient of the same displacement field to the fit's order and the internal force stays -dE/du
-// (the corrected g are just other vectors), so momentum, objectivity and the symmetric tangent are
-// kept.
+// conjugate gradients preconditioned by the sparse Cholesky factor of the assembled matrix,
+// shifted by 1e-9 of its diagonal; lambda polynomial up to the fit's order is its null space, and
+// the defect's part along it is the O(h^2) quadrature error that no such delta can remove). F stays
+// the gradient of the same displacement field to the fit's order and the internal force stays
+// -dE/du (the corrected g are just other vectors), so momentum, objectivity and the symmetric
+// tangent are kept.
 #pragma once
 
 #include <vector>

@@ -54,7 +54,9 @@ struct IntegrationConstraintSummary {
   bool applied = false;
   double defectBefore = 0.0;  // max_I |a_I - d_I| / max_I |a_I|
   double defectAfter = 0.0;
-  int iterations = 0;  // conjugate-gradient iterations
+  int iterations = 0;       // conjugate-gradient iterations
+  bool factorised = false;  // preconditioned by a Cholesky factor (else by the diagonal)
+  double seconds = 0.0;     // wall time of the whole correction
 };
 
 template <int D>
