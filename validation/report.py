@@ -281,6 +281,15 @@ COLUMNS = {
         ("sigma_rr(a) error %", lambda r: err(r, "srr_a")),
         ("u(0.075) error %", lambda r: err(r, "u_mid")),
     ],
+    "lame_cylinder": [
+        ("u_r(a, L/2) [mm]", _mm("u_a", 6)),
+        ("u_r(a, L/2) error %", lambda r: err(r, "u_a")),
+        ("sigma_tt(a, L/2) [MPa]", lambda r: f3(val(r, "stt_a") / 1e6
+                                                if val(r, "stt_a") is not None else None, 2)),
+        ("sigma_tt(a, L/2) error %", lambda r: err(r, "stt_a")),
+        ("sigma_rr(a, L/2) error %", lambda r: err(r, "srr_a")),
+        ("u_r(a, 0) error %", lambda r: err(r, "u_end")),
+    ],
     "plate_hole_fitted": [
         ("Kt (node)", lambda r: f3(val(r, "kt_top"), 3)),
         ("Kt vs FEM %", lambda r: err(r, "kt_top")),
@@ -327,6 +336,7 @@ CONVERGENCE = {
     "plate_hole": [("end_ux", "end_ux", "FEM"), ("kt_top", "kt_top", "FEM"),
                    ("kt_top_vs_peterson", "kt_top", "Peterson")],
     "lame_ring": [("u_a", "u_a", "Lame"), ("stt_a", "stt_a", "Lame")],
+    "lame_cylinder": [("u_a", "u_a", "FEM"), ("stt_a", "stt_a", "FEM"), ("u_end", "u_end", "FEM")],
     "plate_hole_fitted": [("kt_top", "kt_top", "FEM"), ("end_ux", "end_ux", "FEM"),
                           ("kt_top_kernel", "kt_top_kernel", "FEM")],
     "bracket": [("ux_P", "ux_P", "FEM"), ("uz_P", "uz_P", "FEM")],
@@ -347,6 +357,7 @@ SUMMARY_EXTRA = {
                                      ("mid-edge u_y vs FEM", "edge_mid_uy")],
     "plate_hole": [("Kt (probe) vs FEM", "kt_top"), ("vs Peterson", "kt_top_vs_peterson")],
     "lame_ring": [("sigma_tt(a) vs Lame", "stt_a")],
+    "lame_cylinder": [("sigma_tt(a, L/2) vs FEM", "stt_a")],
     "plate_hole_fitted": [("end u_x vs FEM", "end_ux")],
     "bracket": [("u_z(P) vs FEM", "uz_P")],
 }
@@ -373,7 +384,8 @@ PRIMARY_AGAINST = {"oscillating_plate": "thin plate", "cantilever_static": "FEM"
                    "cantilever_dynamic": "Timoshenko", "csm1": "Turek-Hron",
                    "csm3": "Turek-Hron", "clamped_plate": "FEM", "cantilever_large": "FEM",
                    "cook_membrane": "FEM", "cook_membrane_incompressible": "FEM",
-                   "plate_hole": "FEM", "lame_ring": "Lame", "plate_hole_fitted": "FEM",
+                   "plate_hole": "FEM", "lame_ring": "Lame", "lame_cylinder": "FEM",
+                   "plate_hole_fitted": "FEM",
                    "bracket": "FEM"}
 
 
@@ -411,6 +423,9 @@ def reference_value(R, key, error_name):
         ("plate_hole_fitted", "kt_top_kernel"): ph.get("kt_top_fem"),
         ("lame_ring", "u_a"): R.get("lame_ring", {}).get("u_a"),
         ("lame_ring", "stt_a"): R.get("lame_ring", {}).get("stt_a"),
+        ("lame_cylinder", "u_a"): R.get("lame_cylinder", {}).get("u_a"),
+        ("lame_cylinder", "stt_a"): R.get("lame_cylinder", {}).get("stt_a"),
+        ("lame_cylinder", "u_end"): R.get("lame_cylinder", {}).get("u_end"),
         ("bracket", "ux_P"): R.get("bracket", {}).get("ux_P"),
         ("bracket", "uz_P"): R.get("bracket", {}).get("uz_P"),
     })
@@ -1205,6 +1220,16 @@ def references_section(R):
                  "sigma_tt(a) = **%.4e Pa**, sigma_rr(a) = %.4e Pa, u(0.075) = %.5e m "
                  "(validation/references.py `lame_ring`)." % (
                      lr["u_a"], lr["stt_a"], lr["srr_a"], lr["u_mid"]))
+    lc = R.get("lame_cylinder")
+    if lc:
+        L.append("- **Lame cylinder, 3D** (`lame_cylinder.ini`): the ring's cross-section "
+                 "extruded to L = 0.05 m (validation/geometry/lame_cylinder.geo), ends free, "
+                 "the outer surface clamped; CalculiX CAX8 (axisymmetric, quadratic) on "
+                 "n x n meshes to n = 256, Richardson: u_r(a, L/2) = **%.6e m**, "
+                 "sigma_tt(a, L/2) = **%.5e Pa** (nodal), sigma_rr(a, L/2) = %.4e Pa, "
+                 "u_r(a, 0) = %.6e m; a C3D10 model of the same gmsh geometry agrees to "
+                 "4e-4 (validation/lame_cylinder_fem.py, lame_cylinder_fem.json)." % (
+                     lc["u_a"], lc["stt_a"], lc["srr_a"], lc["u_end"]))
     if R.get("plate_hole_fitted") and ph:
         L.append("- **Plate with a hole, fitted** (`plate_hole_fitted.ini`): the same FEM "
                  "references as the plate with a hole (Kt = %.4f, u_x(0.4, 0.05) = %.5f mm)."
@@ -1288,6 +1313,12 @@ NOTES.update({
                  "the nodes at (a, 0) (u_x, sigma_yy) and (0, a) (u_y, sigma_xx), read by "
                  "nearest-particle probes (the particle's own stress). u(0.075) from a "
                  "kernel probe.",
+    "lame_cylinder": "Body from gmsh (validation/geometry/lame_cylinder.geo, "
+                     "OpenCASCADE solid, tetrahedra): particles = the mesh's corner "
+                     "nodes, pressure on \"bore\", nodal clamp on \"outer\". 'Per thickness' "
+                     "= elements through the wall. u_r and sigma_tt at mid-length are the "
+                     "means of the nodes at (a, 0, L/2) and (0, a, L/2) (nearest-particle "
+                     "probes, the particle's own stress); u_r(a, 0) at the free end.",
     "plate_hole_fitted": "The plate with a hole of `plate_hole.ini`, the body from gmsh "
                          "(validation/geometry/plate_hole.geo, quadrangles fitted to the "
                          "hole): nodal clamp on \"left\", the traction on \"right\" with "

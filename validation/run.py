@@ -69,6 +69,7 @@ import references as refs  # noqa: E402
 
 FEM_JSON = HERE / "fem" / "references.json"  # validation/fem.py's point values (committed)
 BRACKET_FEM_JSON = HERE / "bracket_fem.json"  # validation/bracket_fem.py's (committed)
+LAME_CYLINDER_FEM_JSON = HERE / "lame_cylinder_fem.json"  # validation/lame_cylinder_fem.py's
 FEM_OUT = HERE / "fem" / "out"  # its VTU files (git-ignored), for `tlsph compare`
 
 # The FEM case (validation/fem.py CASES) of each problem that has one, and whether its VTU is
@@ -247,6 +248,12 @@ def compute_references(fem_path=FEM_JSON):
     r["lame_ring"] = {"u_a": ring(0.05)[0], "u_mid": ring(0.075)[0],
                       "srr_a": ring(0.05)[1], "stt_a": ring(0.05)[2],
                       "source": "Lame: u_r = A r + B / r, u(b) = 0, sigma_rr(a) = -p"}
+    # The same cylinder in 3D, length L = 0.05 m, ends free: CalculiX CAX8 ladder
+    # (validation/lame_cylinder_fem.py), converged value (Richardson) at mid-length and at the end.
+    cy = json.loads(LAME_CYLINDER_FEM_JSON.read_text())["reference"]
+    r["lame_cylinder"] = {"u_a": cy["ur_mid"]["value"], "stt_a": cy["stt_mid"]["value"],
+                          "srr_a": cy["srr_mid"]["value"], "u_end": cy["ur_end"]["value"],
+                          "source": rel(LAME_CYLINDER_FEM_JSON) + ": CAX8 ladder, Richardson"}
     # L-bracket: CalculiX C3D10, graded mesh ladder (validation/bracket_fem.py).
     br = json.loads(BRACKET_FEM_JSON.read_text())["reference"]
     r["bracket"] = {k: br[k]["reference"] for k in ("ux_P", "uz_P")}
@@ -582,14 +589,27 @@ def extract_lame_ring(series, summary, R):
     u_x, u_y = series["bore_x_ux"][-1], series["bore_y_uy"][-1]
     s_x, s_y = series["bore_x_syy"][-1], series["bore_y_sxx"][-1]
     r_x, r_y = series["bore_x_sxx"][-1], series["bore_y_syy"][-1]
-    um = series["mid_x_ux"][-1]
     v = {"u_a": 0.5 * (u_x + u_y), "u_a_x": u_x, "u_a_y": u_y, "stt_a": 0.5 * (s_x + s_y),
-         "stt_a_x": s_x, "stt_a_y": s_y, "srr_a": 0.5 * (r_x + r_y), "u_mid": um}
+         "stt_a_x": s_x, "stt_a_y": s_y, "srr_a": 0.5 * (r_x + r_y)}
     e = {"u_a": pct(v["u_a"], ref["u_a"]), "stt_a": pct(v["stt_a"], ref["stt_a"]),
          "u_a_x": pct(u_x, ref["u_a"]), "u_a_y": pct(u_y, ref["u_a"]),
          "stt_a_x": pct(s_x, ref["stt_a"]), "stt_a_y": pct(s_y, ref["stt_a"]),
-         "srr_a": pct(v["srr_a"], ref["srr_a"]), "u_mid": pct(um, ref["u_mid"])}
+         "srr_a": pct(v["srr_a"], ref["srr_a"])}
+    if "mid_x_ux" in series:  # the 2D ring's kernel probe inside the wall
+        v["u_mid"] = series["mid_x_ux"][-1]
+        e["u_mid"] = pct(v["u_mid"], ref["u_mid"])
     return {"values": v, "errors": e, "primary": "u_a"}
+
+
+def extract_lame_cylinder(series, summary, R):
+    """The ring's quantities at mid-length of the 3D cylinder, from the bore nodes at
+    (a, 0, L/2) and (0, a, L/2); u_r at the free end from the node at (a, 0, 0)."""
+    out = extract_lame_ring(series, summary, {"lame_ring": R["lame_cylinder"]})
+    ref = R["lame_cylinder"]
+    ue = series["end_x_ux"][-1]
+    out["values"]["u_end"] = ue
+    out["errors"]["u_end"] = pct(ue, ref["u_end"])
+    return out
 
 
 def extract_bracket(series, summary, R):
@@ -705,6 +725,10 @@ NEWTON_MEMORY = {  # measured peak resident memory of the Newton runs (multigrid
 # 1e-7 to 4e-5 relative at tolerance 1e-5).
 NEWTON_AGREEMENT = 10.0
 
+# The mesh bodies with a pressure-loaded curved surface, also with the gradient correction that
+# makes a uniform stress balance its tractions (docs/method.md section 3.4).
+LAME_VARIANTS = [("", {}), ("ic", {"kernel.integration_constraint": "true"})]
+
 PROBLEMS = [
     Problem("oscillating_plate", "Oscillating plate (Gray, Monaghan & Swift 2001), 2D",
             "oscillating_plate.ini", 2, 0.02, [0.005, 0.0025, 0.00125], 0.005, 0.0025,
@@ -797,7 +821,13 @@ PROBLEMS = [
             [0.05 / 8, 0.05 / 16, 0.05 / 32], 0.05 / 8, 0.05 / 8, extract_lame_ring, True,
             "bore radial displacement u(a)", "m", target=("u_a", 1.0),
             checked=["u_a", "stt_a"], clamps=["outer"], newton_memory=(32, 0.22, 2.5),
-            quick_twin=True, agree=["u_a", "stt_a"]),
+            quick_twin=True, agree=["u_a", "stt_a"], variants=LAME_VARIANTS),
+    Problem("lame_cylinder", "Thick-walled cylinder in 3D (Lame) under internal pressure, "
+            "gmsh body, ends free, static", "lame_cylinder.ini", 3, 0.05,
+            [0.05 / 8, 0.05 / 16], 0.05 / 8, 0.05 / 8, extract_lame_cylinder, True,
+            "bore radial displacement u_r(a, L/2)", "m", target=("u_a", 1.0),
+            checked=["u_a", "stt_a", "u_end"], clamps=["outer"],
+            newton_memory=(16, 1.09, 3.0), agree=["u_a", "stt_a"], variants=LAME_VARIANTS),
     Problem("plate_hole_fitted", "Plate with a central hole in tension, gmsh body fitted to "
             "the hole, plane strain, static, 2D", "plate_hole_fitted.ini", 2, 0.02,
             [0.0025, 0.00125, 0.000625], 0.0025, 0.0025, extract_plate_hole_fitted, True,
