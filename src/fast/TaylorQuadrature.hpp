@@ -437,28 +437,10 @@ class TaylorQuadrature {
     return a <= b ? a * D - a * (a - 1) / 2 + (b - a) : sym(b, a);
   }
 
-  // The general term (method/TaylorCorrection.hpp) of particle i from its F and G_a:
-  // C0 : e_a, C0 : E (E = 1/2 (F^T F - 1), or sym(F - 1) for the linear-elastic material), and
-  // sigma_a = sum_b N_ab C0 : e_b + mu_a C0 : E, tau = sum_a mu_a C0 : e_a.
-  struct GeneralStresses {
-    Gradients s, sigma;  // C0 : e_a, sigma_a
-    Mat<D> S, tau;       // C0 : E, tau
-  };
+  // The general term's stresses of particle i (method/TaylorCorrection.hpp's formula).
+  using GeneralStresses = TaylorStresses<D>;
   GeneralStresses generalStresses(Index i, const Mat<D>& F, const Gradients& G) const {
-    const bool small = smallStrain_[i];
-    GeneralStresses t;
-    for (int a = 0; a < D; ++a)
-      t.s[a] = stressOf(i, small ? G[a] : Mat<D>(F.transpose() * G[a]));
-    const Mat<D> I = Mat<D>::Identity();
-    t.S = stressOf(i, small ? Mat<D>(F - I) : Mat<D>(0.5 * (F.transpose() * F - I)));
-    t.tau.setZero();
-    for (int a = 0; a < D; ++a) {
-      t.sigma[a] = offset_[i][a] * t.S;
-      for (int b = 0; b < D; ++b)
-        t.sigma[a] += spread_[i](a, b) * t.s[b];
-      t.tau += offset_[i][a] * t.s[a];
-    }
-    return t;
+    return taylorTermStresses<D>(offset_[i], spread_[i], lambda_[i], mu_[i], smallStrain_[i], F, G);
   }
   // P^q = sum_a G_a sigma_a + F tau (tau for the linear-elastic material), keeping the
   // hyperstress R_a = F sigma_a (sigma_a). Not inlined: the lattice pass around its call stays
@@ -478,16 +460,8 @@ class TaylorQuadrature {
   }
   // V_I [1/2 sum_ab N_ab e_a : C0 : e_b + sum_a mu_a (C0 : E) : e_a]
   double generalEnergy(Index i, const Mat<D>& F, const Gradients& G) const {
-    const GeneralStresses t = generalStresses(i, F, G);
-    double e = 0.0;
-    for (int a = 0; a < D; ++a) {
-      const Mat<D> A = smallStrain_[i] ? G[a] : Mat<D>(F.transpose() * G[a]);
-      const Mat<D> ea = 0.5 * (A + A.transpose());
-      for (int b = 0; b < D; ++b)
-        e += 0.5 * spread_[i](a, b) * (t.s[b].array() * ea.array()).sum();
-      e += offset_[i][a] * (t.S.array() * ea.array()).sum();
-    }
-    return volume_[i] * e;
+    return volume_[i] * taylorTermEnergyDensity<D>(offset_[i], spread_[i], smallStrain_[i], F, G,
+                                                   generalStresses(i, F, G));
   }
   // dP^q and dR_a: the plain term's formula (method/TaylorCorrection.hpp).
   TaylorLinearised<D> generalLinearised(Index i, const Mat<D>& F, const Gradients& G,

@@ -67,6 +67,55 @@ template <int D>
 std::vector<Mat<D>> fitSecondDerivatives(const ReferenceConfiguration<D>& ref,
                                          const std::vector<double>& volume, Index i);
 
+// One particle's stresses of the term at (F, G), given its constants (mu, N, lambda, mu_lame,
+// small: linear-elastic): C0 : e_a and C0 : E, and from them
+//   sigma_a = sum_b N_ab C0 : e_b + mu_a C0 : E,   tau = sum_a mu_a C0 : e_a;
+// the plain term and the fast pass (fast/TaylorQuadrature.hpp) both call it.
+template <int D>
+struct TaylorStresses {
+  std::array<Mat<D>, D> s, sigma;  // C0 : e_a, sigma_a
+  Mat<D> S, tau;                   // C0 : E, tau
+};
+template <int D>
+TaylorStresses<D> taylorTermStresses(const Vec<D>& offset, const Mat<D>& spread, double lambda,
+                                     double mu, bool small, const Mat<D>& F,
+                                     const std::array<Mat<D>, D>& G) {
+  auto C0 = [&](const Mat<D>& A) -> Mat<D> {  // C0 : sym(A)
+    const Mat<D> e = 0.5 * (A + A.transpose());
+    return lambda * e.trace() * Mat<D>::Identity() + 2.0 * mu * e;
+  };
+  TaylorStresses<D> t;
+  for (int a = 0; a < D; ++a)
+    t.s[a] = C0(small ? G[a] : Mat<D>(F.transpose() * G[a]));
+  const Mat<D> I = Mat<D>::Identity();
+  t.S = C0(small ? Mat<D>(F - I) : Mat<D>(0.5 * (F.transpose() * F - I)));
+  t.tau.setZero();
+  for (int a = 0; a < D; ++a) {
+    t.sigma[a] = offset[a] * t.S;
+    for (int b = 0; b < D; ++b)
+      t.sigma[a] += spread(a, b) * t.s[b];
+    t.tau += offset[a] * t.s[a];
+  }
+  return t;
+}
+
+// The bracket of E_q for one particle, 1/2 sum_ab N_ab e_a : C0 : e_b + sum_a mu_a (C0 : E) : e_a
+// (times V_I in E_q), from its stresses t at (F, G).
+template <int D>
+double taylorTermEnergyDensity(const Vec<D>& offset, const Mat<D>& spread, bool small,
+                               const Mat<D>& F, const std::array<Mat<D>, D>& G,
+                               const TaylorStresses<D>& t) {
+  double e = 0.0;
+  for (int a = 0; a < D; ++a) {
+    const Mat<D> A = small ? G[a] : Mat<D>(F.transpose() * G[a]);
+    const Mat<D> ea = 0.5 * (A + A.transpose());  // e_a
+    for (int b = 0; b < D; ++b)
+      e += 0.5 * spread(a, b) * (t.s[b].array() * ea.array()).sum();
+    e += offset[a] * (t.S.array() * ea.array()).sum();
+  }
+  return e;
+}
+
 // The linearisation of one particle's P^q and R_a (TaylorCorrection::stress and hyperstress)
 // about (F, G) in a direction whose displacement gradient is dH and second gradients dG, given
 // the particle's constants (mu, N, lambda, mu_lame, small: linear-elastic) and its sigma_a and
@@ -144,64 +193,19 @@ class TaylorCorrection {
     return G;
   }
 
-  // e_a = sym(F^T G_a), or sym(G_a) for the linear-elastic material.
-  Mat<D> strain(Index i, const Mat<D>& F, const Mat<D>& Ga) const {
-    const Mat<D> A = smallStrain_[i] ? Ga : Mat<D>(F.transpose() * Ga);
-    return 0.5 * (A + A.transpose());
-  }
-
-  // E = 1/2 (F^T F - 1), or sym(F - 1) for the linear-elastic material.
-  Mat<D> greenStrain(Index i, const Mat<D>& F) const {
-    const Mat<D> I = Mat<D>::Identity();
-    if (smallStrain_[i]) return 0.5 * (F + F.transpose()) - I;
-    return 0.5 * (F.transpose() * F - I);
-  }
-
-  // C0 : e
-  Mat<D> smallStrainStress(Index i, const Mat<D>& e) const {
-    return lambda_[i] * e.trace() * Mat<D>::Identity() + 2.0 * mu_[i] * e;
-  }
-
   // E_q for the F and G of every particle.
   double energy(const std::vector<Mat<D>>& F, const std::vector<Gradients>& G) const {
     double E = 0.0;
-    for (Index i = 0; i < ref_.particleCount(); ++i) {
-      Gradients e, s;  // e_a and C0 : e_a
-      for (int a = 0; a < D; ++a) {
-        e[a] = strain(i, F[i], G[i][a]);
-        s[a] = smallStrainStress(i, e[a]);
-      }
-      const Mat<D> S = smallStrainStress(i, greenStrain(i, F[i]));  // C0 : E
-      double Ei = 0.0;  // 1/2 sum_ab N_ab e_a : C0 : e_b + sum_a mu_a (C0 : E) : e_a
-      for (int a = 0; a < D; ++a) {
-        for (int b = 0; b < D; ++b)
-          Ei += 0.5 * spread_[i](a, b) * (e[a].array() * s[b].array()).sum();
-        Ei += offset_[i][a] * (S.array() * e[a].array()).sum();
-      }
-      E += volume_[i] * Ei;
-    }
+    for (Index i = 0; i < ref_.particleCount(); ++i)
+      E += volume_[i] * taylorTermEnergyDensity<D>(offset_[i], spread_[i], smallStrain_[i], F[i],
+                                                   G[i], stresses(i, F[i], G[i]));
     return E;
   }
 
-  // sigma_a = sum_b N_ab C0 : e_b + mu_a C0 : E (sigma[0 .. D-1]) and tau = sum_a mu_a C0 : e_a.
-  struct Stresses {
-    Gradients sigma;
-    Mat<D> tau;
-  };
+  // sigma_a and tau (taylorTermStresses above).
+  using Stresses = TaylorStresses<D>;
   Stresses stresses(Index i, const Mat<D>& F, const Gradients& G) const {
-    Gradients s;  // C0 : e_a
-    for (int a = 0; a < D; ++a)
-      s[a] = smallStrainStress(i, strain(i, F, G[a]));
-    const Mat<D> S = smallStrainStress(i, greenStrain(i, F));
-    Stresses t;
-    t.tau.setZero();
-    for (int a = 0; a < D; ++a) {
-      t.sigma[a] = offset_[i][a] * S;
-      for (int b = 0; b < D; ++b)
-        t.sigma[a] += spread_[i](a, b) * s[b];
-      t.tau += offset_[i][a] * s[a];
-    }
-    return t;
+    return taylorTermStresses<D>(offset_[i], spread_[i], lambda_[i], mu_[i], smallStrain_[i], F, G);
   }
 
   // P^q_I = sum_a G_a sigma_a + F tau (tau for the linear-elastic material, whose e_a has no F).
