@@ -197,6 +197,18 @@ def _mm(name, digits=3):
     return lambda r: f3(val(r, name) * MM if val(r, name) is not None else None, digits)
 
 
+def _lame_columns(at, extra, u="u"):
+    """The bore's displacement and stresses of a Lame problem, read at `at`, then `extra`."""
+    return [
+        ("%s%s [mm]" % (u, at), _mm("u_a", 6)),
+        ("%s%s error %%" % (u, at), lambda r: err(r, "u_a")),
+        ("sigma_tt%s [MPa]" % at, lambda r: f3(val(r, "stt_a") / 1e6
+                                               if val(r, "stt_a") is not None else None, 2)),
+        ("sigma_tt%s error %%" % at, lambda r: err(r, "stt_a")),
+        ("sigma_rr%s error %%" % at, lambda r: err(r, "srr_a")),
+    ] + extra
+
+
 COLUMNS = {
     "oscillating_plate": [
         ("T [s]", lambda r: f3(val(r, "period"), 5)),
@@ -272,24 +284,9 @@ COLUMNS = {
         ("Kt vs FEM %", lambda r: err(r, "kt_top")),
         ("Kt vs Peterson %", lambda r: err(r, "kt_top_vs_peterson")),
     ],
-    "lame_ring": [
-        ("u(a) [mm]", _mm("u_a", 6)),
-        ("u(a) error %", lambda r: err(r, "u_a")),
-        ("sigma_tt(a) [MPa]", lambda r: f3(val(r, "stt_a") / 1e6
-                                          if val(r, "stt_a") is not None else None, 2)),
-        ("sigma_tt(a) error %", lambda r: err(r, "stt_a")),
-        ("sigma_rr(a) error %", lambda r: err(r, "srr_a")),
-        ("u(0.075) error %", lambda r: err(r, "u_mid")),
-    ],
-    "lame_cylinder": [
-        ("u_r(a, L/2) [mm]", _mm("u_a", 6)),
-        ("u_r(a, L/2) error %", lambda r: err(r, "u_a")),
-        ("sigma_tt(a, L/2) [MPa]", lambda r: f3(val(r, "stt_a") / 1e6
-                                                if val(r, "stt_a") is not None else None, 2)),
-        ("sigma_tt(a, L/2) error %", lambda r: err(r, "stt_a")),
-        ("sigma_rr(a, L/2) error %", lambda r: err(r, "srr_a")),
-        ("u_r(a, 0) error %", lambda r: err(r, "u_end")),
-    ],
+    "lame_ring": _lame_columns("(a)", [("u(0.075) error %", lambda r: err(r, "u_mid"))]),
+    "lame_cylinder": _lame_columns("(a, L/2)", [("u_r(a, 0) error %", lambda r: err(r, "u_end"))],
+                                   "u_r"),
     "plate_hole_fitted": [
         ("Kt (node)", lambda r: f3(val(r, "kt_top"), 3)),
         ("Kt vs FEM %", lambda r: err(r, "kt_top")),
