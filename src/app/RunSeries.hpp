@@ -34,6 +34,24 @@ std::vector<std::string> probeColumns(const SceneSetup<D>& setup) {
   return columns;
 }
 
+// The Cauchy stress a surface probe recovers at its particle (method/SurfaceStress.hpp) at
+// time t, from the particles' present displacements; `F` is the particle's own, the first guess.
+template <int D>
+Mat3 surfaceStressOf(const SceneSetup<D>& setup, const Probe<D>& probe, const Mat<D>& F, double t) {
+  Vec<D> dead = Vec<D>::Zero();
+  double following = 0.0;
+  for (const auto& traction : probe.tractions) {
+    dead += traction.ramp.factor(t) * traction.dead;
+    following += traction.ramp.factor(t) * traction.followingPressure;
+  }
+  const Index i = probe.stencil->particle;
+  const Mat<D> H =
+      recoveredDisplacementGradient<D>(*probe.stencil, setup.scene.particles.displacement,
+                                       setup.scene.materials[setup.scene.particles.material[i]],
+                                       dead, following, F - Mat<D>::Identity());
+  return cauchyStressOf(setup, Mat<D>(Mat<D>::Identity() + H), i);
+}
+
 template <int D>
 std::vector<double> probeRow(const SceneSetup<D>& setup, const Solver<D>& solver) {
   const auto& p = setup.scene.particles;
@@ -43,10 +61,15 @@ std::vector<double> probeRow(const SceneSetup<D>& setup, const Solver<D>& solver
   for (const auto& probe : setup.probes)
     for (const auto& q : probe.quantities) {
       if (q == "cauchy_stress") {
-        // The weighted particle stresses (Shepard; the probe's weights), xx yy zz xy yz xz.
+        // The weighted particle stresses (Shepard; the probe's weights), xx yy zz xy yz xz; a
+        // surface probe's recovered from the surface and its traction.
         Mat3 s = Mat3::Zero();
-        for (std::size_t k = 0; k < probe.particles.size(); ++k)
-          s += probe.weights[k] * cauchyStressOf(setup, F[probe.particles[k]], probe.particles[k]);
+        if (probe.stencil)
+          s = surfaceStressOf(setup, probe, F[probe.particles[0]], solver.time());
+        else
+          for (std::size_t k = 0; k < probe.particles.size(); ++k)
+            s +=
+                probe.weights[k] * cauchyStressOf(setup, F[probe.particles[k]], probe.particles[k]);
         row.insert(row.end(), {s(0, 0), s(1, 1), s(2, 2), s(0, 1), s(1, 2), s(0, 2)});
         continue;
       }

@@ -66,7 +66,14 @@ void printSetup(const SceneSetup<D>& setup, const Solver<D>& solver) {
   for (const auto& probe : setup.probes)
     std::cout << "probe        " << probe.name << " at (" << probe.point.transpose() << "), "
               << (probe.method == ProbeMethod::Nearest ? "nearest particle"
-                                                       : "kernel-interpolated, first order")
+                  : probe.method == ProbeMethod::Kernel
+                      ? "kernel-interpolated, first order"
+                      : "particle " + std::to_string(probe.particles[0]) + " of surface " +
+                            probe.surfaceName +
+                            ", stress recovered from the "
+                            "surface (" +
+                            std::to_string(probe.stencil->neighbours.size()) +
+                            " particles) and its traction")
               << "\n";
   if (setup.run.newtonStatic()) {
     const double end = solver.rampEnd();

@@ -138,6 +138,7 @@ class Builder {
   void readCheckpoint();
   void readGuard();
   void readProbes();
+  void resolveSurfaceProbe(Probe<D>& probe, const SurfacePatch<D>& surface);
 
   const Config& config_;
   SceneSetup<D> setup_;

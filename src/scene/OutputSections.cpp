@@ -84,16 +84,30 @@ void Builder<D>::readProbes() {
     Probe<D> probe;
     probe.name = name;
     probe.point = r.vector<D>("point");
-    probe.method = r.word("method", "nearest", {"nearest", "kernel"}) == "nearest"
-                       ? ProbeMethod::Nearest
-                       : ProbeMethod::Kernel;
+    const std::string method = r.word("method", "nearest", {"nearest", "kernel", "surface"});
+    probe.method = method == "nearest"  ? ProbeMethod::Nearest
+                   : method == "kernel" ? ProbeMethod::Kernel
+                                        : ProbeMethod::Surface;
+    const SurfacePatch<D>* surface = nullptr;
+    if (probe.method == ProbeMethod::Surface) {
+      surface = &namedSurface(r);
+      probe.surfaceName = config_.get("probe." + name, "surface");
+      probe.fitRadius = r.positive("fit_radius", 1.0) * setup_.scene.supportRadius;
+    } else {
+      for (const char* key : {"surface", "fit_radius"})
+        if (r.has(key))
+          throw r.error(key, std::string("is read only with method = surface (a stress recovered "
+                                         "at a named surface)"));
+    }
     probe.quantities = r.words("quantities", {"displacement"});
     for (const auto& q : probe.quantities)
       if (q != "displacement" && q != "velocity" && q != "cauchy_stress")
         throw r.error("quantities", "unknown quantity '" + q +
                                         "'; expected displacement, velocity, cauchy_stress");
     r.finish();
-    if (probe.method == ProbeMethod::Nearest) {
+    if (surface) {
+      resolveSurfaceProbe(probe, *surface);
+    } else if (probe.method == ProbeMethod::Nearest) {
       // Of equally near particles, the first in the lattice's order (latticeOrderBefore):
       // the choice depends on the particles' places, not on their numbering.
       const auto& X = p.referencePosition;
@@ -131,13 +145,70 @@ void Builder<D>::readProbes() {
   }
 }
 
+// A surface probe (method = surface): the particle of the surface nearest to the point, the
+// stress recovery's fit there (method/SurfaceStress.hpp) over the surface particles within
+// fit_radius (in kernel supports), and the traction of each load on that surface.
+template <int D>
+void Builder<D>::resolveSurfaceProbe(Probe<D>& probe, const SurfacePatch<D>& surface) {
+  const auto& p = setup_.scene.particles;
+  const auto& X = p.referencePosition;
+  const std::string section = "probe." + probe.name;
+  std::size_t best = 0;
+  for (std::size_t k = 1; k < surface.particles.size(); ++k) {
+    const double dk = (X[surface.particles[k]] - probe.point).squaredNorm(),
+                 db = (X[surface.particles[best]] - probe.point).squaredNorm();
+    if (dk < db ||
+        (dk == db && latticeOrderBefore<D>(X[surface.particles[k]], X[surface.particles[best]])))
+      best = k;
+  }
+  const Index i = surface.particles[best];
+  const std::string which = "the particle of surface '" + probe.surfaceName + "' nearest to " +
+                            fmt<D>(probe.point) + " (particle " + std::to_string(i) + " at " +
+                            fmt<D>(X[i]) + ")";
+  if (p.motion[i] != Motion::Free)
+    throw InputError(config_.where(section, "surface"), section, "surface",
+                     which +
+                         " is held or moved by a condition: there the traction is the "
+                         "condition's reaction, not known in advance; a surface probe reads a "
+                         "loaded or free surface");
+  std::string why;
+  probe.stencil = surfaceStencil<D>(i, X, surface.particles, surface.areaVector,
+                                    surface.areaVector[best], probe.fitRadius, why);
+  if (!probe.stencil)
+    throw InputError(config_.where(section, "surface"), section, "surface",
+                     "the stress recovery at " + which + " has " + why +
+                         "; a finer dx or a larger fit_radius puts more surface particles in the "
+                         "fit");
+  probe.particles = {i};
+  probe.weights = {1.0};
+  // The loads on this surface, as tractions per unit reference area at particle i: a pressure
+  // -p N, a traction its force over the particle's share of the area.
+  for (const auto& load : setup_.scene.loads) {
+    const std::string loadSection = load.name;
+    if (!config_.has(loadSection, "surface") ||
+        config_.get(loadSection, "surface") != probe.surfaceName)
+      continue;
+    ProbeTraction<D> t;
+    t.ramp = load.ramp;
+    if (load.following)
+      t.followingPressure = load.following->pressure();
+    else if (config_.get(loadSection, "type") == "pressure")
+      t.dead = load.force[best] / surface.areaVector[best].norm();
+    else
+      t.dead = load.force[best] / surface.area[best];
+    probe.tractions.push_back(t);
+  }
+}
+
 template void Builder<2>::readOutput();
 template void Builder<2>::readCheckpoint();
 template void Builder<2>::readGuard();
 template void Builder<2>::readProbes();
+template void Builder<2>::resolveSurfaceProbe(Probe<2>&, const SurfacePatch<2>&);
 template void Builder<3>::readOutput();
 template void Builder<3>::readCheckpoint();
 template void Builder<3>::readGuard();
 template void Builder<3>::readProbes();
+template void Builder<3>::resolveSurfaceProbe(Probe<3>&, const SurfacePatch<3>&);
 
 }  // namespace tlsph::scene_build

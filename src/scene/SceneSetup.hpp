@@ -3,11 +3,13 @@
 #pragma once
 
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "explicit/Solver.hpp"
 #include "implicit/NewtonSolver.hpp"
+#include "method/SurfaceStress.hpp"
 #include "model/Scene.hpp"
 #include "model/SurfacePatch.hpp"
 
@@ -51,7 +53,16 @@ struct GuardSettings {
                               // scale, or the hourglass energy is that far below zero; 0: off
 };
 
-enum class ProbeMethod { Nearest, Kernel };
+enum class ProbeMethod { Nearest, Kernel, Surface };
+
+// A load on a surface probe's surface, as the traction it puts on the probe's particle at the
+// full ramp: dead (per unit reference area) or a following pressure.
+template <int D>
+struct ProbeTraction {
+  Ramp ramp;
+  Vec<D> dead = Vec<D>::Zero();
+  double followingPressure = 0.0;
+};
 
 template <int D>
 struct Probe {
@@ -63,6 +74,11 @@ struct Probe {
   std::vector<Index> particles;
   std::vector<double> weights;
   std::vector<Vec<D>> offsets;  // Kernel: point - X_J, for the first-order correction
+  // Surface: the stress recovery's fit at the particle and the loads on its surface.
+  std::string surfaceName;
+  double fitRadius = 0.0;  // [m]
+  std::optional<SurfaceStencil<D>> stencil;
+  std::vector<ProbeTraction<D>> tractions;
 };
 
 template <int D>
