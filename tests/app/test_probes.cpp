@@ -1,6 +1,7 @@
 // Probes: a kernel probe carries each particle's displacement to the probe point with its
 // deformation gradient, so it is exact for affine fields, also at a surface point outside the
-// particle cloud's hull (a beam tip); a nearest probe reports the nearest particle's value.
+// particle cloud's hull (a beam tip); a nearest probe reports the nearest particle's value; a
+// surface probe recovers the stress from its surface and the traction of the loads on it.
 #include <gtest/gtest.h>
 
 #include "app/RunSeries.hpp"
@@ -107,4 +108,63 @@ TEST(Probes, KernelProbeIsExactForAffineFieldsAtSurfacePoints) {
   EXPECT_NEAR(value("tip_syz"), 0.0, bound);
   EXPECT_NEAR(value("tip_sxz"), 0.0, bound);
   EXPECT_GT(std::abs(sigma(2, 2)), 1e-3 * scale);
+}
+
+// A surface probe on the Lame ring's bore under a pressure p: for the uniform in-plane strain
+// whose stress is -p 1 in the plane (in equilibrium with that pressure on every surface), it
+// reads sigma = -p 1 from the surface's displacements and the load's traction, and reports the
+// particle's own displacement. A wrong traction (sign, area, ramp) would change its normal part.
+TEST(Probes, SurfaceProbeRecoversTheStressFromTheLoadsTraction) {
+  const std::string text = R"(
+[scene]
+dimension = 2
+dx = 0.00625
+[material.steel]
+model = linear-elastic
+density = 7800
+youngs_modulus = 2e11
+poisson_ratio = 0.3
+[body.ring]
+shape = mesh
+file = )" TLSPH_SOURCE_DIR R"(/validation/geometry/lame_ring.geo
+[load.p]
+surface = bore
+type = pressure
+value = 1e8
+[time]
+end = 1
+[probe.s]
+point = 0.03 0.04
+method = surface
+surface = bore
+quantities = displacement cauchy_stress
+)";
+  SceneSetup<2> setup = buildScene<2>(Config::parse(text, "ring.ini"));
+  const double E = 2e11, nu = 0.3, p = 1e8;
+  const double lambda = E * nu / ((1 + nu) * (1 - 2 * nu)), mu = E / (2 * (1 + nu));
+  const double e = -p / (2 * (lambda + mu));
+  auto& particles = setup.scene.particles;
+  for (Index i = 0; i < particles.size(); ++i)
+    particles.displacement[i] = e * particles.referencePosition[i];
+  Solver<2> solver(setup.scene, setup.solver);
+  const auto row = probeRow(setup, solver);
+  const auto columns = probeColumns(setup);
+  auto value = [&](const std::string& column) {
+    const auto at = std::find(columns.begin(), columns.end(), column);
+    EXPECT_NE(at, columns.end()) << column;
+    return row[at - columns.begin()];
+  };
+  const Probe<2>& probe = setup.probes.front();
+  const Index i = probe.particles.front();
+  EXPECT_NEAR(particles.referencePosition[i].norm(), 0.05, 1e-12);  // a bore node
+  EXPECT_LT((particles.referencePosition[i] - Vec<2>(0.03, 0.04)).norm(), 0.00625);
+  EXPECT_EQ(value("s_ux"), particles.displacement[i].x());
+  // The material's P (small strain: P = -p 1 in the plane), as the Cauchy stress P F^T / J.
+  const Mat3 sigma = cauchyStressOf(setup, Mat<2>((1 + e) * Mat<2>::Identity()), i);
+  EXPECT_NEAR(sigma(0, 0), -p * (1 - e), 1e-6 * p);
+  EXPECT_NEAR(value("s_sxx"), sigma(0, 0), 1e-9 * p);
+  EXPECT_NEAR(value("s_syy"), sigma(1, 1), 1e-9 * p);
+  EXPECT_NEAR(value("s_sxy"), 0.0, 1e-9 * p);
+  EXPECT_NEAR(value("s_szz"), sigma(2, 2), 1e-9 * p);
+  EXPECT_NEAR(sigma(2, 2), 2 * lambda * e, 1e-3 * p);
 }
