@@ -206,6 +206,11 @@ def _lame_columns(at, extra, u="u"):
                                                if val(r, "stt_a") is not None else None, 2)),
         ("sigma_tt%s error %%" % at, lambda r: err(r, "stt_a")),
         ("sigma_rr%s error %%" % at, lambda r: err(r, "srr_a")),
+        ("sigma_tt%s recovered [MPa]" % at, lambda r: f3(val(r, "stt_s") / 1e6
+                                                         if val(r, "stt_s") is not None
+                                                         else None, 2)),
+        ("its error %", lambda r: err(r, "stt_s")),
+        ("(a, 0) / (0, a) %", lambda r: "%s / %s" % (err(r, "stt_s_x"), err(r, "stt_s_y"))),
     ] + extra
 
 
@@ -332,8 +337,9 @@ CONVERGENCE = {
                                      ("edge_mid_uy", "edge_mid_uy", "FEM")],
     "plate_hole": [("end_ux", "end_ux", "FEM"), ("kt_top", "kt_top", "FEM"),
                    ("kt_top_vs_peterson", "kt_top", "Peterson")],
-    "lame_ring": [("u_a", "u_a", "Lame"), ("stt_a", "stt_a", "Lame")],
-    "lame_cylinder": [("u_a", "u_a", "FEM"), ("stt_a", "stt_a", "FEM"), ("u_end", "u_end", "FEM")],
+    "lame_ring": [("u_a", "u_a", "Lame"), ("stt_s", "stt_s", "Lame"), ("stt_a", "stt_a", "Lame")],
+    "lame_cylinder": [("u_a", "u_a", "FEM"), ("stt_s", "stt_s", "FEM"), ("stt_a", "stt_a", "FEM"),
+                      ("u_end", "u_end", "FEM")],
     "plate_hole_fitted": [("kt_top", "kt_top", "FEM"), ("end_ux", "end_ux", "FEM"),
                           ("kt_top_kernel", "kt_top_kernel", "FEM")],
     "bracket": [("ux_P", "ux_P", "FEM"), ("uz_P", "uz_P", "FEM")],
@@ -353,8 +359,8 @@ SUMMARY_EXTRA = {
     "cook_membrane_incompressible": [("u_x vs FEM", "corner_ux"),
                                      ("mid-edge u_y vs FEM", "edge_mid_uy")],
     "plate_hole": [("Kt (probe) vs FEM", "kt_top"), ("vs Peterson", "kt_top_vs_peterson")],
-    "lame_ring": [("sigma_tt(a) vs Lame", "stt_a")],
-    "lame_cylinder": [("sigma_tt(a, L/2) vs FEM", "stt_a")],
+    "lame_ring": [("sigma_tt(a) vs Lame", "stt_a"), ("recovered", "stt_s")],
+    "lame_cylinder": [("sigma_tt(a, L/2) vs FEM", "stt_a"), ("recovered", "stt_s")],
     "plate_hole_fitted": [("end u_x vs FEM", "end_ux")],
     "bracket": [("u_z(P) vs FEM", "uz_P")],
 }
@@ -420,8 +426,10 @@ def reference_value(R, key, error_name):
         ("plate_hole_fitted", "kt_top_kernel"): ph.get("kt_top_fem"),
         ("lame_ring", "u_a"): R.get("lame_ring", {}).get("u_a"),
         ("lame_ring", "stt_a"): R.get("lame_ring", {}).get("stt_a"),
+        ("lame_ring", "stt_s"): R.get("lame_ring", {}).get("stt_a"),
         ("lame_cylinder", "u_a"): R.get("lame_cylinder", {}).get("u_a"),
         ("lame_cylinder", "stt_a"): R.get("lame_cylinder", {}).get("stt_a"),
+        ("lame_cylinder", "stt_s"): R.get("lame_cylinder", {}).get("stt_a"),
         ("lame_cylinder", "u_end"): R.get("lame_cylinder", {}).get("u_end"),
         ("bracket", "ux_P"): R.get("bracket", {}).get("ux_P"),
         ("bracket", "uz_P"): R.get("bracket", {}).get("uz_P"),
@@ -1308,14 +1316,17 @@ NOTES.update({
                  "nodes, the \"outer\" nodes are held (nodal clamp). 'Per thickness' = "
                  "elements through the wall (0.05 m). u(a) and sigma_tt(a) are the means of "
                  "the nodes at (a, 0) (u_x, sigma_yy) and (0, a) (u_y, sigma_xx), read by "
-                 "nearest-particle probes (the particle's own stress). u(0.075) from a "
-                 "kernel probe.",
+                 "nearest-particle probes (the particle's own stress); 'recovered': the "
+                 "same nodes' stress recovered from the bore and its pressure (surface "
+                 "probes, docs/method.md section 3.5). u(0.075) from a kernel probe.",
     "lame_cylinder": "Body from gmsh (validation/geometry/lame_cylinder.geo, "
                      "OpenCASCADE solid, tetrahedra): particles = the mesh's corner "
                      "nodes, pressure on \"bore\", nodal clamp on \"outer\". 'Per thickness' "
                      "= elements through the wall. u_r and sigma_tt at mid-length are the "
                      "means of the nodes at (a, 0, L/2) and (0, a, L/2) (nearest-particle "
-                     "probes, the particle's own stress); u_r(a, 0) at the free end.",
+                     "probes, the particle's own stress; 'recovered': surface probes at "
+                     "the same nodes, docs/method.md section 3.5); u_r(a, 0) at the free "
+                     "end.",
     "plate_hole_fitted": "The plate with a hole of `plate_hole.ini`, the body from gmsh "
                          "(validation/geometry/plate_hole.geo, quadrangles fitted to the "
                          "hole): nodal clamp on \"left\", the traction on \"right\" with "

@@ -595,6 +595,11 @@ def extract_lame_ring(series, summary, R):
          "u_a_x": pct(u_x, ref["u_a"]), "u_a_y": pct(u_y, ref["u_a"]),
          "stt_a_x": pct(s_x, ref["stt_a"]), "stt_a_y": pct(s_y, ref["stt_a"]),
          "srr_a": pct(v["srr_a"], ref["srr_a"])}
+    if "surf_x_syy" in series:  # the stress recovered from the bore and its pressure
+        s_x, s_y = series["surf_x_syy"][-1], series["surf_y_sxx"][-1]
+        v.update({"stt_s": 0.5 * (s_x + s_y), "stt_s_x": s_x, "stt_s_y": s_y})
+        e.update({"stt_s": pct(v["stt_s"], ref["stt_a"]), "stt_s_x": pct(s_x, ref["stt_a"]),
+                  "stt_s_y": pct(s_y, ref["stt_a"])})
     if "mid_x_ux" in series:  # the 2D ring's kernel probe inside the wall
         v["u_mid"] = series["mid_x_ux"][-1]
         e["u_mid"] = pct(v["u_mid"], ref["u_mid"])
@@ -820,13 +825,15 @@ PROBLEMS = [
             "plane strain, static, 2D", "lame_ring.ini", 2, 0.05,
             [0.05 / 8, 0.05 / 16, 0.05 / 32], 0.05 / 8, 0.05 / 8, extract_lame_ring, True,
             "bore radial displacement u(a)", "m", target=("u_a", 1.0),
-            checked=["u_a", "stt_a"], clamps=["outer"], newton_memory=(32, 0.22, 2.5),
-            quick_twin=True, agree=["u_a", "stt_a"], variants=LAME_VARIANTS),
+            checked=["u_a", "stt_a", "stt_s"], clamps=["outer"], newton_memory=(32, 0.22, 2.5),
+            quick_twin=True, agree=["u_a", "stt_a"],
+            variants=LAME_VARIANTS + [("ic-s2.5", {"kernel.integration_constraint": "true",
+                                                   "kernel.support": "2.5"})]),
     Problem("lame_cylinder", "Thick-walled cylinder in 3D (Lame) under internal pressure, "
             "gmsh body, ends free, static", "lame_cylinder.ini", 3, 0.05,
             [0.05 / 8, 0.05 / 16], 0.05 / 8, 0.05 / 8, extract_lame_cylinder, True,
             "bore radial displacement u_r(a, L/2)", "m", target=("u_a", 1.0),
-            checked=["u_a", "stt_a", "u_end"], clamps=["outer"],
+            checked=["u_a", "stt_a", "stt_s", "u_end"], clamps=["outer"],
             newton_memory=(16, 1.09, 3.0), agree=["u_a", "stt_a"], variants=LAME_VARIANTS),
     Problem("plate_hole_fitted", "Plate with a central hole in tension, gmsh body fitted to "
             "the hole, plane strain, static, 2D", "plate_hole_fitted.ini", 2, 0.02,
