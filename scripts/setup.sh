@@ -55,11 +55,13 @@ fi
 if [ "$action" = sanitize ]; then
   # The fast test suite (without the validation label) built with AddressSanitizer and
   # UndefinedBehaviorSanitizer, in its own build directory. The MPI tests (label mpi) are left
-  # out: Open MPI's own allocations at exit are reported as leaks.
+  # out: Open MPI's own allocations at exit are reported as leaks. libgmsh's own leaks are
+  # suppressed (tests/lsan.supp).
   build_dir="${BUILD_DIR:-build-sanitize}"
   cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTLSPH_SANITIZE=ON >/dev/null
   cmake --build "$build_dir" -j "$jobs"
-  ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
+  LSAN_OPTIONS="suppressions=$PWD/tests/lsan.supp" \
+    ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
     ctest --test-dir "$build_dir" --output-on-failure -j "$jobs" -LE 'validation|mpi'
   exit 0
 fi
