@@ -63,18 +63,17 @@ void printSetup(const SceneSetup<D>& setup, const Solver<D>& solver) {
   if (setup.scene.damping.any())
     std::cout << "damping      viscous " << setup.scene.damping.viscous << " 1/s, kinetic "
               << (setup.scene.damping.kinetic ? "on" : "off") << "\n";
-  for (const auto& probe : setup.probes)
-    std::cout << "probe        " << probe.name << " at (" << probe.point.transpose() << "), "
-              << (probe.method == ProbeMethod::Nearest ? "nearest particle"
-                  : probe.method == ProbeMethod::Kernel
-                      ? "kernel-interpolated, first order"
-                      : "particle " + std::to_string(probe.particles[0]) + " of surface " +
-                            probe.surfaceName +
-                            ", stress recovered from the "
-                            "surface (" +
-                            std::to_string(probe.stencil->neighbours.size()) +
-                            " particles) and its traction")
-              << "\n";
+  for (const auto& probe : setup.probes) {
+    std::cout << "probe        " << probe.name << " at (" << probe.point.transpose() << "), ";
+    if (probe.method == ProbeMethod::Nearest)
+      std::cout << "nearest particle\n";
+    else if (probe.method == ProbeMethod::Kernel)
+      std::cout << "kernel-interpolated, first order\n";
+    else
+      std::cout << "particle " << probe.particles[0] << " of surface " << probe.surfaceName
+                << ", stress recovered from the surface (" << probe.stencil->neighbours.size()
+                << " particles) and its traction\n";
+  }
   if (setup.run.newtonStatic()) {
     const double end = solver.rampEnd();
     std::cout << "static       Newton-Raphson, " << setup.run.newton.loadSteps

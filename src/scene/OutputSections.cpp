@@ -12,6 +12,21 @@ namespace tlsph::scene_build {
 
 namespace {
 
+// The position in `candidates` of the particle nearest to `point`; of equally near ones the
+// first in the lattice's order (latticeOrderBefore), so that the choice depends on the
+// particles' places, not on their numbering.
+template <int D>
+std::size_t nearestTo(const Vec<D>& point, const std::vector<Vec<D>>& X,
+                      const std::vector<Index>& candidates) {
+  std::size_t best = 0;
+  for (std::size_t k = 1; k < candidates.size(); ++k) {
+    const Vec<D>&Y = X[candidates[k]], &B = X[candidates[best]];
+    const double dk = (Y - point).squaredNorm(), db = (B - point).squaredNorm();
+    if (dk < db || (dk == db && latticeOrderBefore<D>(Y, B))) best = k;
+  }
+  return best;
+}
+
 const std::vector<std::string> kFieldNames = {"displacement",    "velocity",      "J",
                                               "von_mises",       "cauchy_stress", "first_piola",
                                               "hourglass_error", "flags"};
@@ -108,19 +123,10 @@ void Builder<D>::readProbes() {
     if (surface) {
       resolveSurfaceProbe(probe, *surface);
     } else if (probe.method == ProbeMethod::Nearest) {
-      // Of equally near particles, the first in the lattice's order (latticeOrderBefore):
-      // the choice depends on the particles' places, not on their numbering.
-      const auto& X = p.referencePosition;
-      auto before = [&](Index i, Index j) {
-        const double di = (X[i] - probe.point).squaredNorm(),
-                     dj = (X[j] - probe.point).squaredNorm();
-        if (di != dj) return di < dj;
-        return latticeOrderBefore<D>(X[i], X[j]);
-      };
-      Index best = 0;
-      for (Index i = 1; i < bodyCount_; ++i)
-        if (before(i, best)) best = i;
-      probe.particles = {best};
+      std::vector<Index> body(bodyCount_);
+      for (Index i = 0; i < bodyCount_; ++i)
+        body[i] = i;
+      probe.particles = {body[nearestTo<D>(probe.point, p.referencePosition, body)]};
       probe.weights = {1.0};
     } else {
       // Shepard-normalised kernel interpolation over the reference neighbourhood; each
@@ -153,14 +159,7 @@ void Builder<D>::resolveSurfaceProbe(Probe<D>& probe, const SurfacePatch<D>& sur
   const auto& p = setup_.scene.particles;
   const auto& X = p.referencePosition;
   const std::string section = "probe." + probe.name;
-  std::size_t best = 0;
-  for (std::size_t k = 1; k < surface.particles.size(); ++k) {
-    const double dk = (X[surface.particles[k]] - probe.point).squaredNorm(),
-                 db = (X[surface.particles[best]] - probe.point).squaredNorm();
-    if (dk < db ||
-        (dk == db && latticeOrderBefore<D>(X[surface.particles[k]], X[surface.particles[best]])))
-      best = k;
-  }
+  const std::size_t best = nearestTo<D>(probe.point, X, surface.particles);
   const Index i = surface.particles[best];
   const std::string which = "the particle of surface '" + probe.surfaceName + "' nearest to " +
                             fmt<D>(probe.point) + " (particle " + std::to_string(i) + " at " +
@@ -184,15 +183,14 @@ void Builder<D>::resolveSurfaceProbe(Probe<D>& probe, const SurfacePatch<D>& sur
   // The loads on this surface, as tractions per unit reference area at particle i: a pressure
   // -p N, a traction its force over the particle's share of the area.
   for (const auto& load : setup_.scene.loads) {
-    const std::string loadSection = load.name;
-    if (!config_.has(loadSection, "surface") ||
-        config_.get(loadSection, "surface") != probe.surfaceName)
+    if (!config_.has(load.name, "surface") ||
+        config_.get(load.name, "surface") != probe.surfaceName)
       continue;
     ProbeTraction<D> t;
     t.ramp = load.ramp;
     if (load.following)
       t.followingPressure = load.following->pressure();
-    else if (config_.get(loadSection, "type") == "pressure")
+    else if (config_.get(load.name, "type") == "pressure")
       t.dead = load.force[best] / surface.areaVector[best].norm();
     else
       t.dead = load.force[best] / surface.area[best];

@@ -4,6 +4,9 @@
 // surface probe recovers the stress from its surface and the traction of the loads on it.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include "app/RunSeries.hpp"
 #include "scene/Config.hpp"
 #include "scene/SceneBuilder.hpp"
@@ -39,6 +42,14 @@ point = 0.2 0.02
 method = nearest
 )";
 
+// The value of a probes.csv column in a row.
+double columnValue(const std::vector<std::string>& columns, const std::vector<double>& row,
+                   const std::string& column) {
+  const auto at = std::find(columns.begin(), columns.end(), column);
+  EXPECT_NE(at, columns.end()) << column;
+  return at == columns.end() ? std::nan("") : row[at - columns.begin()];
+}
+
 }  // namespace
 
 TEST(Probes, KernelProbeIsExactForAffineFieldsAtSurfacePoints) {
@@ -55,11 +66,7 @@ TEST(Probes, KernelProbeIsExactForAffineFieldsAtSurfacePoints) {
   const auto row = probeRow(setup, solver);
   const auto columns = probeColumns(setup);
   ASSERT_EQ(row.size(), columns.size());
-  auto value = [&](const std::string& column) {
-    const auto at = std::find(columns.begin(), columns.end(), column);
-    EXPECT_NE(at, columns.end()) << column;
-    return row[at - columns.begin()];
-  };
+  auto value = [&](const std::string& column) { return columnValue(columns, row, column); };
   const Vec<2> tip = c + G * Vec<2>(0.2, 0.02), corner = c + G * Vec<2>(0.2, 0.04);
   EXPECT_NEAR(value("tip_ux"), tip.x(), 1e-14);
   EXPECT_NEAR(value("tip_uy"), tip.y(), 1e-14);
@@ -149,11 +156,7 @@ quantities = displacement cauchy_stress
   Solver<2> solver(setup.scene, setup.solver);
   const auto row = probeRow(setup, solver);
   const auto columns = probeColumns(setup);
-  auto value = [&](const std::string& column) {
-    const auto at = std::find(columns.begin(), columns.end(), column);
-    EXPECT_NE(at, columns.end()) << column;
-    return row[at - columns.begin()];
-  };
+  auto value = [&](const std::string& column) { return columnValue(columns, row, column); };
   const Probe<2>& probe = setup.probes.front();
   const Index i = probe.particles.front();
   EXPECT_NEAR(particles.referencePosition[i].norm(), 0.05, 1e-12);  // a bore node
