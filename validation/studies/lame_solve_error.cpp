@@ -13,7 +13,7 @@
 //
 // The first argument is the number of elements through the wall; the others are overrides of
 // validation/scenes/lame_ring.ini. K is applied as the change of the net force (exact for this
-// linear problem) inside plain conjugate gradients.
+// linear problem) inside the project's conjugate gradients, unpreconditioned.
 #include <algorithm>
 #include <cmath>
 #include <complex>
@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "explicit/Solver.hpp"
+#include "implicit/ConjugateGradients.hpp"
 #include "implicit/NewtonSolver.hpp"
 #include "materials/Material.hpp"
 #include "method/SurfaceStress.hpp"
@@ -33,13 +34,19 @@ using namespace tlsph;
 
 namespace {
 
-// validation/scenes/lame_ring.ini
-constexpr double kE = 2e11, kNu = 0.3, kA = 0.05, kB = 0.1, kP = 1e8;
-const double kLambda = kE * kNu / ((1 + kNu) * (1 - 2 * kNu)), kMu = kE / (2 * (1 + kNu));
-const double kBc = kP / (2 * (kLambda + kMu) / (kB * kB) + 2 * kMu / (kA * kA));
-const double kAc = -kBc / (kB * kB);
-const double kHoop = 2 * (kLambda + kMu) * kAc + 2 * kMu * kBc / (kA * kA);
-const double kUa = kAc * kA + kBc / kA;
+// validation/scenes/lame_ring.ini: the ring's radii and the bore's pressure.
+constexpr double kA = 0.05, kB = 0.1, kP = 1e8;
+
+// The plane-strain Lame solution u_r = A r + B / r for the scene's material.
+struct Lame {
+  double lambda, mu, A, B, hoop, ua;
+  explicit Lame(const ElasticConstants& c) : lambda(c.lambda), mu(c.mu) {
+    B = kP / (2 * (lambda + mu) / (kB * kB) + 2 * mu / (kA * kA));
+    A = -B / (kB * kB);
+    hoop = 2 * (lambda + mu) * A + 2 * mu * B / (kA * kA);
+    ua = A * kA + B / kA;
+  }
+};
 
 using Field = std::vector<Vec<2>>;
 
@@ -78,6 +85,8 @@ int main(int argc, char** argv) try {
   const auto n = particles.size();
   const double dx = setup.dx;
 
+  const Material& material = scene.materials[0];
+  const Lame lame(elasticConstants(material));
   Solver<2> solver(scene, setup.solver);
   NewtonSettings settings;
   settings.tolerance = 1e-10;
@@ -91,7 +100,7 @@ int main(int argc, char** argv) try {
   for (Index i = 0; i < n; ++i) {
     const Vec<2> X = particles.referencePosition[i];
     const double r = X.norm();
-    exact[i] = (kAc * r + kBc / r) * X / r;
+    exact[i] = (lame.A * r + lame.B / r) * X / r;
   }
   // The net force (internal plus the loads at full pressure) on the free particles.
   auto netForce = [&](const Field& u, Field& f) {
@@ -105,34 +114,25 @@ int main(int argc, char** argv) try {
   Field residual, loadOnly;
   netForce(exact, residual);
   netForce(Field(n, Vec<2>::Zero()), loadOnly);
-  auto dot = [&](const Field& x, const Field& y) {
-    double s = 0.0;
-    for (Index i = 0; i < n; ++i)
-      s += x[i].dot(y[i]);
-    return s;
-  };
-  auto applyK = [&](const Field& v, Field& Kv) {
-    netForce(v, Kv);
-    for (Index i = 0; i < n; ++i)
-      Kv[i] = loadOnly[i] - Kv[i];
-  };
+  // K v = -(the change of the net force), exact for this linear problem; plain conjugate
+  // gradients (the fixed particles' rows and right sides are zero).
   auto solveK = [&](const Field& rhs) {
-    Field x(n, Vec<2>::Zero()), r = rhs, d = rhs, q;
-    double rr = dot(r, r);
-    const double stop = 1e-24 * rr;
-    for (int it = 0; it < 100000 && rr > stop; ++it) {
-      applyK(d, q);
-      const double step = rr / dot(d, q);
-      for (Index i = 0; i < n; ++i) {
-        x[i] += step * d[i];
-        r[i] -= step * q[i];
-      }
-      const double next = dot(r, r);
-      for (Index i = 0; i < n; ++i)
-        d[i] = r[i] + next / rr * d[i];
-      rr = next;
-    }
-    return x;
+    auto flat = [](const Field& f) {
+      return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(f[0].data(), 2 * f.size()));
+    };
+    Field v(n), Kv;
+    auto applyK = [&](const Eigen::VectorXd& x, Eigen::VectorXd& out) {
+      Eigen::Map<Eigen::VectorXd>(v[0].data(), 2 * n) = x;
+      netForce(v, Kv);
+      out = flat(loadOnly) - flat(Kv);
+    };
+    const Eigen::VectorXd b = flat(rhs);
+    Eigen::VectorXd x = Eigen::VectorXd::Zero(b.size());
+    conjugateGradients(
+        applyK, [](const Eigen::VectorXd& r) { return r; }, b, x, 1e-12 * b.norm(), 100000, 100000);
+    Field out(n);
+    Eigen::Map<Eigen::VectorXd>(out[0].data(), 2 * n) = x;
+    return out;
   };
 
   const SurfacePatch<2>& bore = setup.surfaces.at("bore");
@@ -145,7 +145,6 @@ int main(int argc, char** argv) try {
       throw std::runtime_error("bore particle " + std::to_string(bore.particles[k]) + ": " + why);
     stencils.push_back(*s);
   }
-  const Material& material = scene.materials[0];
   // The recovered hoop stress's error at every bore node, per cent.
   auto hoopErrors = [&](const Field& u) {
     std::vector<double> e;
@@ -155,8 +154,8 @@ int main(int argc, char** argv) try {
           recoveredDisplacementGradient<2>(s, u, material, Vec<2>(-kP * N), 0.0, Mat<2>::Zero());
       const Mat<2> strain = 0.5 * (H + H.transpose());
       const Vec<2> t(-N.y(), N.x());
-      const double hoop = kLambda * strain.trace() + 2 * kMu * t.dot(strain * t);
-      e.push_back(100 * (hoop / kHoop - 1));
+      const double hoop = lame.lambda * strain.trace() + 2 * lame.mu * t.dot(strain * t);
+      e.push_back(100 * (hoop / lame.hoop - 1));
     }
     return statisticsOf(e);
   };
@@ -173,7 +172,7 @@ int main(int argc, char** argv) try {
     std::vector<double> e;
     for (Index i : bore.particles) {
       const Vec<2> X = particles.referencePosition[i];
-      e.push_back(100 * (solved[i].dot(X.normalized()) / kUa - 1));
+      e.push_back(100 * (solved[i].dot(X.normalized()) / lame.ua - 1));
     }
     print("u_r at the bore nodes, % vs Lame", statisticsOf(e));
   }
@@ -213,7 +212,7 @@ int main(int argc, char** argv) try {
   for (Index i : bore.particles) {
     const Vec<2> X = particles.referencePosition[i];
     const Vec<2> t = Vec<2>(-X.y(), X.x()).normalized();
-    along.emplace_back(std::atan2(X.y(), X.x()), (solved[i] - exact[i]).dot(t) / kUa);
+    along.emplace_back(std::atan2(X.y(), X.x()), (solved[i] - exact[i]).dot(t) / lame.ua);
   }
   std::sort(along.begin(), along.end());
   const std::size_t m = along.size();
