@@ -63,7 +63,8 @@ class ForceEvaluator {
                                     Kernel<D>(scene_.kernel, scene_.supportRadius),
                                     scene_.periodicBox, scene_.gradientCorrection,
                                     scene_.quadrature, scene_.particles.quadratureMoments(),
-                                    scene_.particles.boundaryArea)),
+                                    scene_.particles.boundaryArea, scene_.particles.boundaryMoment,
+                                    scene_.integrationFilter)),
         forces_(ref_, scene_.materials, scene_.particles.material, scene_.particles.volume,
                 scene_.hourglass(), scene_.quadrature, scene_.viscosity, 0.5 * scene_.supportRadius,
                 {}, scene_.particles.quadratureMoments()) {}

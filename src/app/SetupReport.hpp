@@ -33,12 +33,19 @@ void printSetup(const SceneSetup<D>& setup, const Solver<D>& solver) {
             << gradientCorrectionName(setup.scene.gradientCorrection) << " gradient correction, "
             << (setup.scene.quadrature == Quadrature::Taylor ? "Taylor-corrected" : "nodal")
             << " quadrature)\n";
-  if (const auto& ic = solver.integrationConstraint(); ic.applied)
+  if (const auto& ic = solver.integrationConstraint(); ic.applied && !ic.linear)
     std::cout << "integration  gradient vectors corrected for the boundary's area vectors: defect "
               << ic.defectBefore << " -> " << ic.defectAfter << " of the largest a_I ("
               << ic.iterations << " CG iterations, "
               << (ic.factorised ? "Cholesky-preconditioned" : "Jacobi-preconditioned") << ", "
               << ic.seconds << " s)\n";
+  else if (ic.applied)
+    std::cout << "integration  gradient vectors corrected for the boundary's area vectors and "
+                 "first moments (linear stress, filter "
+              << ic.filter << "): defect " << ic.defectBefore << " -> " << ic.defectAfter
+              << " of the largest a_I, first moments " << ic.momentDefectBefore << " -> "
+              << ic.momentDefectAfter << " of V_I; correction |delta|/|g| " << ic.correction << " ("
+              << ic.iterations << " CG iterations, " << ic.seconds << " s)\n";
   std::cout << "hourglass    alpha = " << setup.scene.hourglassCoefficient
             << (setup.scene.hourglassCoefficient == 0
                     ? std::string(" (off)")

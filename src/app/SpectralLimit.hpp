@@ -24,7 +24,8 @@ SpectralEstimate estimateSpectralStep(const Scene<D>& scene, const Solver<D>& so
     const auto whole = buildSceneReference<D>(
         scene.particles.referencePosition, scene.particles.volume,
         Kernel<D>(scene.kernel, scene.supportRadius), scene.periodicBox, scene.gradientCorrection,
-        scene.quadrature, scene.particles.quadratureMoments(), scene.particles.boundaryArea);
+        scene.quadrature, scene.particles.quadratureMoments(), scene.particles.boundaryArea,
+        scene.particles.boundaryMoment, scene.integrationFilter);
     f = highestFrequency(scene, whole);
     numbers = {f.made ? 1.0 : 0.0, f.lambda, double(f.particle), double(f.products), f.seconds};
   }

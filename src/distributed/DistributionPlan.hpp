@@ -140,7 +140,7 @@ ReferenceConfiguration<D> buildPairData(const Scene<D>& scene, const Kernel<D>& 
     return buildSceneReference<D>(scene.particles.referencePosition, scene.particles.volume, kernel,
                                   scene.periodicBox, scene.gradientCorrection, scene.quadrature,
                                   scene.particles.quadratureMoments(), scene.particles.boundaryArea,
-                                  rows);
+                                  scene.particles.boundaryMoment, scene.integrationFilter, rows);
   };
   if (!plan.active) return build(nullptr);
   ReferenceConfiguration<D> ref;

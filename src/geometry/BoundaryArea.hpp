@@ -4,6 +4,13 @@
 // of the vector area of its boundary loop. Every facet's vector area is that of a closed loop,
 // so the a_I of a closed boundary sum to zero to rounding, as the integration constraint
 // (method/IntegrationConstraint.hpp) needs.
+//
+// The first moments b_I = int lambda_I (X - X_I) (x) n dA, for the linear-stress constraint, on
+// the same facets with the hats' products exact on each: a facet of area vector A_f adds
+// w (X_J - X_I) (x) A_f for each other corner J, w = int lambda_I lambda_J dA / A: 1/6 on a
+// segment, 1/12 on a triangle, on a parallelogram 1/18 for adjacent corners and 1/36 for
+// opposite ones. With a_I they satisfy the divergence theorem for the linear fields:
+// sum_I (b_I + X_I (x) a_I) = int X (x) n dA = Vol 1.
 #pragma once
 
 #include <algorithm>
@@ -36,11 +43,13 @@ inline std::vector<std::vector<int>> elementFaces(int corners) {
 
 }  // namespace detail
 
-// cellStart / cellNode: the D-elements by their corner nodes (compressed rows).
+// cellStart / cellNode: the D-elements by their corner nodes (compressed rows). firstMoments:
+// where to put the b_I too, or null.
 template <int D>
 std::vector<Vec<D>> boundaryAreaVectors(const std::vector<Vec<D>>& X,
                                         const std::vector<Index>& cellStart,
-                                        const std::vector<Index>& cellNode) {
+                                        const std::vector<Index>& cellNode,
+                                        std::vector<Mat<D>>* firstMoments = nullptr) {
   // Each facet by its sorted corners: how often it occurs, and its loop oriented out of the
   // first element that has it.
   struct Facet {
@@ -89,6 +98,7 @@ std::vector<Vec<D>> boundaryAreaVectors(const std::vector<Vec<D>>& X,
     }
   }
   std::vector<Vec<D>> area(X.size(), Vec<D>::Zero());
+  if (firstMoments) firstMoments->assign(X.size(), Mat<D>::Zero());
   for (const auto& [key, f] : facets) {
     if (f.count != 1) continue;
     Vec<D> a = Vec<D>::Zero();
@@ -101,6 +111,17 @@ std::vector<Vec<D>> boundaryAreaVectors(const std::vector<Vec<D>>& X,
     }
     for (Index node : f.loop)
       area[node] += a / double(f.loop.size());
+    if (!firstMoments) continue;
+    const std::size_t c = f.loop.size();
+    for (std::size_t q = 0; q < c; ++q)
+      for (std::size_t r = 0; r < c; ++r) {
+        if (r == q) continue;
+        const double w = c == 2             ? 1.0 / 6.0
+                         : c == 3           ? 1.0 / 12.0
+                         : (q + 2) % 4 == r ? 1.0 / 36.0
+                                            : 1.0 / 18.0;
+        (*firstMoments)[f.loop[q]] += w * (X[f.loop[r]] - X[f.loop[q]]) * a.transpose();
+      }
   }
   return area;
 }

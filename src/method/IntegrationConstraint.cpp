@@ -4,9 +4,12 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
+#include <Eigen/QR>
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
+#include <tuple>
 
 #include "implicit/SparseCholesky.hpp"
 #include "method/TaylorCorrection.hpp"
@@ -56,6 +59,10 @@ constexpr int kIntegrationIterations = 3000;
 // The preconditioner's shift, relative to the diagonal: it must keep the factorisation of the
 // semi-definite matrix (null space: the polynomial lambda) safe from rounding.
 constexpr double kIntegrationShift = 1e-9;
+// The linear-stress constraint's solve: the residual falls below this fraction of the right
+// side, or the iterations run out.
+constexpr double kLinearConstraintTolerance = 1e-8;
+constexpr int kLinearConstraintIterations = 20000;
 
 // Per particle K: the W-orthogonal projector onto the pair values that the fit's monomials
 // annihilate, Pi_K y = W y - W P^T M^{-1} P W y, kept as the scaled monomials of each pair and
@@ -244,6 +251,39 @@ void refreshGradientSums(ReferenceConfiguration<D>& ref, const std::vector<doubl
   ref.reverseGradient = reverseVectors<D>(nb, ref.correctedGradient, volume, ref.rows());
 }
 
+// The particles' centroid and their largest distance from it: the scale of the polynomial
+// null spaces' monomials.
+template <int D>
+std::pair<Vec<D>, double> boundingSphere(const std::vector<Vec<D>>& X) {
+  Vec<D> centre = Vec<D>::Zero();
+  for (const auto& x : X)
+    centre += x;
+  centre /= double(X.size());
+  double radius = 0.0;
+  for (const auto& x : X)
+    radius = std::max(radius, (x - centre).norm());
+  return {centre, radius};
+}
+
+// The largest |a_I|, after checking that there is one a_I per particle and that they describe a
+// closed boundary (their sum vanishes; an open one has no consistent correction).
+template <int D>
+double checkedBoundaryScale(const std::vector<Vec<D>>& boundaryArea, Index n) {
+  if (static_cast<Index>(boundaryArea.size()) != n)
+    throw SetupError("the boundary's area vectors are not one per particle");
+  double scale = 0.0;
+  Vec<D> total = Vec<D>::Zero();
+  for (const auto& a : boundaryArea) {
+    scale = std::max(scale, a.norm());
+    total += a;
+  }
+  if (scale == 0.0) throw SetupError("the body's boundary has no area");
+  if (total.norm() > 1e-8 * scale * std::sqrt(double(n)))
+    throw SetupError("the body's boundary is not closed: its area vectors sum to " +
+                     std::to_string(total.norm()) + ", the largest is " + std::to_string(scale));
+  return scale;
+}
+
 }  // namespace
 
 template <int D>
@@ -253,8 +293,7 @@ void enforceIntegrationConstraint(ReferenceConfiguration<D>& ref, const std::vec
                                   const PairArray<Vec<D>>& extra) {
   const auto& nb = ref.neighbours;
   const Index n = ref.particleCount();
-  if (static_cast<Index>(boundaryArea.size()) != n)
-    throw SetupError("the boundary's area vectors are not one per particle");
+  const double scale = checkedBoundaryScale<D>(boundaryArea, n);
   auto defect = [&]() {
     PairArray<Vec<D>> v = ref.correctedGradient;
     if (!extra.empty())
@@ -266,18 +305,6 @@ void enforceIntegrationConstraint(ReferenceConfiguration<D>& ref, const std::vec
       c[i] = boundaryArea[i] - d[i];
     return c;
   };
-  double scale = 0.0;
-  Vec<D> total = Vec<D>::Zero();
-  for (const auto& a : boundaryArea) {
-    scale = std::max(scale, a.norm());
-    total += a;
-  }
-  if (scale == 0.0) throw SetupError("the body's boundary has no area");
-  // A closed boundary's area vectors sum to zero; an open one has no consistent correction.
-  if (total.norm() > 1e-8 * scale * std::sqrt(double(n)))
-    throw SetupError("the body's boundary is not closed: its area vectors sum to " +
-                     std::to_string(total.norm()) + ", the largest is " + std::to_string(scale));
-
   const auto started = std::chrono::steady_clock::now();
   IntegrationConstraintSummary& summary = ref.integrationConstraint;
   summary = {};
@@ -312,13 +339,7 @@ void enforceIntegrationConstraint(ReferenceConfiguration<D>& ref, const std::vec
   // boundary sum of a_I q(X_I), O(h^2), and is left (removed from the right side).
   Eigen::VectorXd b(D * n), lambda = Eigen::VectorXd::Zero(D * n);
   {
-    Vec<D> centre = Vec<D>::Zero();
-    for (Index i = 0; i < n; ++i)
-      centre += X[i];
-    centre /= double(n);
-    double radius = 0.0;
-    for (Index i = 0; i < n; ++i)
-      radius = std::max(radius, (X[i] - centre).norm());
+    const auto [centre, radius] = boundingSphere<D>(X);
     const int T = ref.correction == GradientCorrection::Quadratic ? kQuadraticTerms<D> + 1 : D + 1;
     Eigen::MatrixXd Q(n, T);
     for (Index i = 0; i < n; ++i) {
@@ -405,13 +426,272 @@ void enforceIntegrationConstraint(ReferenceConfiguration<D>& ref, const std::vec
 }
 
 template <int D>
-ReferenceConfiguration<D> buildSceneReference(const std::vector<Vec<D>>& X,
-                                              const std::vector<double>& volume,
-                                              const Kernel<D>& kernel, const PeriodicBox<D>& box,
-                                              GradientCorrection correction, Quadrature quadrature,
-                                              const QuadratureMoments<D>& moments,
-                                              const std::vector<Vec<D>>& boundaryArea,
-                                              const std::vector<Index>* rows) {
+void enforceLinearStressConstraint(ReferenceConfiguration<D>& ref, const std::vector<Vec<D>>& X,
+                                   const std::vector<double>& volume,
+                                   const std::vector<Vec<D>>& boundaryArea,
+                                   const std::vector<Mat<D>>& boundaryMoment, double filter,
+                                   const PairArray<Vec<D>>& extra) {
+  constexpr int U = 1 + D;        // multipliers per particle and component: lambda, then Lambda
+  using Field = Eigen::MatrixXd;  // (U n) x D: particle I's rows U I .. U I + D, a column each
+  const auto& nb = ref.neighbours;
+  const Index n = ref.particleCount();
+  const double scale = checkedBoundaryScale<D>(boundaryArea, n);
+  if (static_cast<Index>(boundaryMoment.size()) != n)
+    throw SetupError("the boundary's first moments are not one per particle");
+  if (!(filter > 0.0)) throw SetupError("the linear-stress constraint needs a positive filter");
+  const auto started = std::chrono::steady_clock::now();
+  IntegrationConstraintSummary& summary = ref.integrationConstraint;
+  summary = {};
+  summary.applied = summary.linear = summary.factorised = true;
+  summary.filter = filter;
+
+  const PairArray<Index> rev = reversePairIndex(nb);
+  // The defects c_I = a_I - d_I and e_I = b_I - V_I 1 - m_I of the vectors g + extra.
+  std::vector<Vec<D>> c(n);
+  std::vector<Mat<D>> e(n);
+  auto defects = [&]() {
+    PairArray<Vec<D>> v = ref.correctedGradient;
+    if (!extra.empty())
+      for (Index k = 0; k < nb.pairCount(); ++k)
+        v[k] += extra[k];
+    const std::vector<Vec<D>> d = quadratureDefect<D>(nb, v, volume);
+#pragma omp parallel for schedule(static)
+    for (Index I = 0; I < n; ++I) {
+      Mat<D> m = Mat<D>::Zero();
+      for (Index k = nb.offset[I]; k < nb.offset[I + 1]; ++k) {
+        const Index J = nb.neighbour[k];
+        // I's moment from the pair (J, I): V_J (X_J - X_I) (x) v_JI
+        m.noalias() += volume[J] * (X[J] - X[I]) * v[rev[k]].transpose();
+      }
+      c[I] = boundaryArea[I] - d[I];
+      e[I] = boundaryMoment[I] - volume[I] * Mat<D>::Identity() - m;
+    }
+    double cMax = 0.0, eMax = 0.0;
+    for (Index I = 0; I < n; ++I) {
+      cMax = std::max(cMax, c[I].norm() / scale);
+      eMax = std::max(eMax, e[I].norm() / volume[I]);
+    }
+    return std::pair<double, double>(cMax, eMax);
+  };
+  std::tie(summary.defectBefore, summary.momentDefectBefore) = defects();
+
+  const Projectors<D> projector(ref, volume);
+  // Lambda in units of lambda per length: scaled by the mean pair distance, so that both kinds of
+  // multiplier weigh alike in the solve and in the null space's bar.
+  double meanDistance = 0.0;
+  for (Index k = 0; k < nb.pairCount(); ++k)
+    meanDistance += ref.separation[k].norm();
+  const double ls = double(nb.pairCount()) / meanDistance;
+
+  PairArray<Vec<D>> y(nb.pairCount()), z(nb.pairCount());
+  auto spread = [&](const Field& mu) {  // z = Pi A^T mu
+#pragma omp parallel for schedule(static)
+    for (Index K = 0; K < n; ++K)
+      for (Index k = nb.offset[K]; k < nb.offset[K + 1]; ++k) {
+        const Index J = nb.neighbour[k];
+        Vec<D> s = (mu.row(U * J) - mu.row(U * K)).transpose();
+        s.noalias() += ls * mu.block(U * J + 1, 0, D, D).transpose() * (X[K] - X[J]);
+        y[k] = volume[K] * s;
+      }
+    projector.apply(nb, y, z);
+  };
+  auto gather = [&](Field& out) {  // out = A z
+#pragma omp parallel for schedule(static)
+    for (Index I = 0; I < n; ++I) {
+      Vec<D> toLambda = Vec<D>::Zero();
+      Mat<D> toMoment = Mat<D>::Zero();
+      for (Index k = nb.offset[I]; k < nb.offset[I + 1]; ++k) {
+        const Index J = nb.neighbour[k], r = rev[k];
+        toLambda += volume[J] * z[r] - volume[I] * z[k];
+        toMoment.noalias() += (ls * volume[J]) * (X[J] - X[I]) * z[r].transpose();
+      }
+      for (int j = 0; j < D; ++j) {  // (element by element: GCC 12 misreads Eigen's packets here)
+        out(U * I, j) = toLambda[j];
+        for (int a = 0; a < D; ++a)
+          out(U * I + 1 + a, j) = toMoment(a, j);
+      }
+    }
+  };
+  auto applyB = [&](const Field& mu, Field& out) {
+    spread(mu);
+    gather(out);
+  };
+  // Lambda's diagonal blocks of B (the same for every component): particle I's multipliers reach
+  // the pairs (K, I) of its neighbours K, one pair value each, V_K (1, ls (X_K - X_I)).
+  std::vector<Mat<D>> momentBlock(n, Mat<D>::Zero());
+  Eigen::VectorXd momentDiagonal(D * n);
+#pragma omp parallel for schedule(static)
+  for (Index I = 0; I < n; ++I) {
+    for (Index k = nb.offset[I]; k < nb.offset[I + 1]; ++k) {
+      const Index K = nb.neighbour[k], r = rev[k];
+      const double w = projector.weight[r];
+      const double pi =
+          w - w * w * projector.basis[r].dot(projector.inverse[K] * projector.basis[r]);
+      const Vec<D> t = ls * (X[K] - X[I]);
+      momentBlock[I] += (volume[K] * volume[K] * pi) * t * t.transpose();
+    }
+    momentDiagonal.template segment<D>(D * I) = momentBlock[I].diagonal();
+  }
+
+  // The preconditioner: lambda's block by the factor of the uniform constraint's matrix (shifted as
+  // there), each particle's Lambda block with the filter's shift by its inverse.
+  SparseCholesky factor;
+  double lambdaLargest = 0.0;  // lambda's largest diagonal entry
+  {
+    SparseCholesky::Matrix B = constraintMatrix<D>(nb, projector, volume);
+    const Eigen::VectorXd diagonal = B.diagonal();
+    lambdaLargest = diagonal.maxCoeff();
+    for (Index i = 0; i < n; ++i)
+      B.coeffRef(i, i) += kIntegrationShift * std::max(diagonal[i], 0.0);
+    if (!factor.factorise(B))
+      throw SetupError("the integration constraint's matrix could not be factorised");
+  }
+  // The null space: B on the span of lambda cubic and Lambda quadratic (monomials of the
+  // positions scaled to the body), its eigenvectors below 1e-10 of the largest diagonal (they
+  // sit at 1e-17; the next eigenvalue at 1e-6).
+  Field Q;
+  {
+    const auto [centre, radius] = boundingSphere<D>(X);
+    std::vector<std::array<int, 3>> powers;
+    for (int a = 0; a <= 3; ++a)
+      for (int b = 0; b <= 3 - a; ++b)
+        for (int g = 0; g <= (D == 3 ? 3 - a - b : 0); ++g)
+          powers.push_back({a, b, g});
+    auto monomial = [&](const std::array<int, 3>& p, Index i) {
+      const Vec<D> x = (X[i] - centre) / radius;
+      double v = 1.0;
+      for (int a = 0; a < D; ++a)
+        for (int q = 0; q < p[a]; ++q)
+          v *= x[a];
+      return v;
+    };
+    std::vector<std::pair<int, std::array<int, 3>>> columns;  // (slot, powers)
+    for (const auto& p : powers)
+      columns.push_back({0, p});
+    for (int a = 0; a < D; ++a)
+      for (const auto& p : powers)
+        if (p[0] + p[1] + p[2] <= 2) columns.push_back({1 + a, p});
+    const int m = int(columns.size());
+    Field P = Field::Zero(U * n, m);
+    for (int q = 0; q < m; ++q)
+      for (Index i = 0; i < n; ++i)
+        P(U * i + columns[q].first, q) = monomial(columns[q].second, i);
+    const Eigen::HouseholderQR<Field> qr(P);
+    const Field basis = qr.householderQ() * Field::Identity(U * n, m);
+    Field Bbasis(U * n, m), in(U * n, D), out(U * n, D);
+    for (int q0 = 0; q0 < m; q0 += D) {
+      in.setZero();
+      for (int j = 0; j < D && q0 + j < m; ++j)
+        in.col(j) = basis.col(q0 + j);
+      applyB(in, out);
+      for (int j = 0; j < D && q0 + j < m; ++j)
+        Bbasis.col(q0 + j) = out.col(j);
+    }
+    Field H = basis.transpose() * Bbasis;
+    H = (0.5 * (H + H.transpose())).eval();
+    const Eigen::SelfAdjointEigenSolver<Field> eigen(H);
+    const double largest = std::max(lambdaLargest, momentDiagonal.maxCoeff());
+    int null = 0;
+    while (null < m && eigen.eigenvalues()[null] < 1e-10 * largest)
+      ++null;
+    Q = basis * eigen.eigenvectors().leftCols(null);
+  }
+  auto project = [&](Field& v) { v -= Q * (Q.transpose() * v); };
+
+  std::vector<Mat<D>> momentInverse(n);
+  for (Index I = 0; I < n; ++I) {
+    Mat<D> s = momentBlock[I];
+    s.diagonal() *= 1.0 + filter;
+    // a pseudo-inverse: a particle whose neighbours all lie on one line or plane has a
+    // singular block
+    const Eigen::SelfAdjointEigenSolver<Mat<D>> eigen(s);
+    const double floor = 1e-12 * std::max(eigen.eigenvalues().maxCoeff(), 0.0);
+    Vec<D> inverse = Vec<D>::Zero();
+    for (int a = 0; a < D; ++a)
+      if (eigen.eigenvalues()[a] > floor) inverse[a] = 1.0 / eigen.eigenvalues()[a];
+    momentInverse[I] =
+        eigen.eigenvectors() * inverse.asDiagonal() * eigen.eigenvectors().transpose();
+  }
+  auto precondition = [&](const Field& r, Field& out) {
+    Eigen::VectorXd component(n);
+    for (int j = 0; j < D; ++j) {
+      for (Index I = 0; I < n; ++I)
+        component[I] = r(U * I, j);
+      const Eigen::VectorXd solved = factor.solve(component);
+      for (Index I = 0; I < n; ++I)
+        out(U * I, j) = solved[I];
+    }
+#pragma omp parallel for schedule(static)
+    for (Index I = 0; I < n; ++I)
+      out.block(U * I + 1, 0, D, D) = momentInverse[I] * r.block(U * I + 1, 0, D, D);
+    project(out);
+  };
+  auto applyFiltered = [&](const Field& mu, Field& out) {
+    applyB(mu, out);
+#pragma omp parallel for schedule(static)
+    for (Index I = 0; I < n; ++I)
+      out.block(U * I + 1, 0, D, D) += filter *
+                                       momentDiagonal.template segment<D>(D * I).asDiagonal() *
+                                       mu.block(U * I + 1, 0, D, D);
+  };
+
+  Field b(U * n, D);
+  for (Index I = 0; I < n; ++I) {
+    b.row(U * I) = c[I].transpose();
+    b.block(U * I + 1, 0, D, D) = ls * e[I];
+  }
+  project(b);
+  // Conjugate gradients, one per component, run side by side.
+  const Eigen::VectorXd target = kLinearConstraintTolerance * b.colwise().norm().transpose();
+  Field mu = Field::Zero(U * n, D), r = b, s(U * n, D), p(U * n, D), Ap(U * n, D);
+  precondition(r, s);
+  p = s;
+  Eigen::VectorXd rs = r.cwiseProduct(s).colwise().sum().transpose();
+  auto converged = [&](int j) { return r.col(j).norm() <= target[j]; };
+  int it = 0;
+  for (; it < kLinearConstraintIterations; ++it) {
+    bool done = true;
+    for (int j = 0; j < D; ++j)
+      done = done && converged(j);
+    if (done) break;
+    applyFiltered(p, Ap);
+    for (int j = 0; j < D; ++j) {
+      if (converged(j)) continue;
+      const double step = rs[j] / p.col(j).dot(Ap.col(j));
+      mu.col(j) += step * p.col(j);
+      r.col(j) -= step * Ap.col(j);
+    }
+    project(r);
+    precondition(r, s);
+    for (int j = 0; j < D; ++j) {
+      if (converged(j)) continue;
+      const double rsNew = r.col(j).dot(s.col(j));
+      p.col(j) = s.col(j) + (rsNew / rs[j]) * p.col(j);
+      rs[j] = rsNew;
+    }
+  }
+  summary.iterations = it;
+  project(mu);
+  spread(mu);
+  double corrected = 0.0, original = 0.0;
+  for (Index k = 0; k < nb.pairCount(); ++k) {
+    corrected += z[k].squaredNorm();
+    original += ref.correctedGradient[k].squaredNorm();
+    ref.correctedGradient[k] += z[k];
+  }
+  summary.correction = std::sqrt(corrected / original);
+  refreshGradientSums<D>(ref, volume);
+  std::tie(summary.defectAfter, summary.momentDefectAfter) = defects();
+  summary.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+}
+
+template <int D>
+ReferenceConfiguration<D> buildSceneReference(
+    const std::vector<Vec<D>>& X, const std::vector<double>& volume, const Kernel<D>& kernel,
+    const PeriodicBox<D>& box, GradientCorrection correction, Quadrature quadrature,
+    const QuadratureMoments<D>& moments, const std::vector<Vec<D>>& boundaryArea,
+    const std::vector<Mat<D>>& boundaryMoment, double filter, const std::vector<Index>* rows) {
   auto build = [&](const std::vector<Index>* some) {
     return buildReferenceConfiguration<D>(X, volume, kernel, box, correction,
                                           kDefaultMinCorrectionCondition, some);
@@ -421,7 +701,10 @@ ReferenceConfiguration<D> buildSceneReference(const std::vector<Vec<D>>& X,
   const PairArray<Vec<D>> extra = quadrature == Quadrature::Taylor
                                       ? taylorPairVectors<D>(whole, volume, moments)
                                       : PairArray<Vec<D>>{};
-  enforceIntegrationConstraint<D>(whole, X, volume, boundaryArea, extra);
+  if (boundaryMoment.empty())
+    enforceIntegrationConstraint<D>(whole, X, volume, boundaryArea, extra);
+  else
+    enforceLinearStressConstraint<D>(whole, X, volume, boundaryArea, boundaryMoment, filter, extra);
   if (!rows) return whole;
   // The rows' lists are the whole build's: their corrected vectors are copied over.
   ReferenceConfiguration<D> part = build(rows);
@@ -456,10 +739,16 @@ template void enforceIntegrationConstraint<3>(ReferenceConfiguration<3>&,
 template ReferenceConfiguration<2> buildSceneReference<2>(
     const std::vector<Vec<2>>&, const std::vector<double>&, const Kernel<2>&, const PeriodicBox<2>&,
     GradientCorrection, Quadrature, const QuadratureMoments<2>&, const std::vector<Vec<2>>&,
-    const std::vector<Index>*);
+    const std::vector<Mat<2>>&, double, const std::vector<Index>*);
+template void enforceLinearStressConstraint<2>(
+    ReferenceConfiguration<2>&, const std::vector<Vec<2>>&, const std::vector<double>&,
+    const std::vector<Vec<2>>&, const std::vector<Mat<2>>&, double, const PairArray<Vec<2>>&);
 template ReferenceConfiguration<3> buildSceneReference<3>(
     const std::vector<Vec<3>>&, const std::vector<double>&, const Kernel<3>&, const PeriodicBox<3>&,
     GradientCorrection, Quadrature, const QuadratureMoments<3>&, const std::vector<Vec<3>>&,
-    const std::vector<Index>*);
+    const std::vector<Mat<3>>&, double, const std::vector<Index>*);
+template void enforceLinearStressConstraint<3>(
+    ReferenceConfiguration<3>&, const std::vector<Vec<3>>&, const std::vector<double>&,
+    const std::vector<Vec<3>>&, const std::vector<Mat<3>>&, double, const PairArray<Vec<3>>&);
 
 }  // namespace tlsph

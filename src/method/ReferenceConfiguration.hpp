@@ -57,6 +57,13 @@ struct IntegrationConstraintSummary {
   int iterations = 0;       // conjugate-gradient iterations
   bool factorised = false;  // preconditioned by a Cholesky factor (else by the diagonal)
   double seconds = 0.0;     // wall time of the whole correction
+  // The linear-stress constraint: its first moments' defect max_I |b_I - V_I 1 - m_I| / V_I
+  // before and after, the filter, and the correction's size |delta| / |g| over all pairs.
+  bool linear = false;
+  double momentDefectBefore = 0.0;
+  double momentDefectAfter = 0.0;
+  double filter = 0.0;
+  double correction = 0.0;
 };
 
 template <int D>

@@ -34,6 +34,9 @@ struct ParticleSet {
   // the gradient vectors stay as fitted. A body meshed from a file sets it and is the scene's
   // only body.
   std::vector<Vec<D>> boundaryArea;
+  // b_I = int lambda_I (X - X_I) (x) n dA over the same boundary, for the linear-stress
+  // constraint only (geometry/BoundaryArea.hpp); empty otherwise.
+  std::vector<Mat<D>> boundaryMoment;
 
   Index size() const { return static_cast<Index>(referencePosition.size()); }
 
@@ -52,6 +55,7 @@ struct ParticleSet {
       quadratureSpread.push_back(latticeSpread<D>(V));
     }
     if (!boundaryArea.empty()) boundaryArea.push_back(Vec<D>::Zero());
+    if (!boundaryMoment.empty()) boundaryMoment.push_back(Mat<D>::Zero());
     return size() - 1;
   }
 

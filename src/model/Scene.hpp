@@ -26,6 +26,9 @@ struct Scene {
   HourglassForm hourglassForm = HourglassForm::Energy;
   HourglassGradient hourglassGradient = HourglassGradient::Corrected;
   ViscositySettings viscosity;  // artificial viscosity (6.77); off by default
+  // The linear-stress constraint's filter ([kernel] integration_filter); 0: that constraint is
+  // off (method/IntegrationConstraint.hpp).
+  double integrationFilter = 0.0;
   PeriodicBox<D> periodicBox;
   Vec<D> gravity = Vec<D>::Zero();  // body force per unit mass
   Ramp gravityRamp;

@@ -146,6 +146,7 @@ class Builder {
   std::size_t maxParticles_ = 0;
   double supportRatio_ = 2.0;
   bool integrationConstraint_ = false;  // [kernel] integration_constraint
+  bool integrationLinear_ = false;      // ... = linear
   Index bodyCount_ = 0;
   std::map<std::array<long, D>, Index> latticeIndex_;  // lattice point -> body particle
   std::array<LatticeAxis, D> lattice_{};               // the bodies' lattice

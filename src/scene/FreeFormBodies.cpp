@@ -85,6 +85,7 @@ void Builder<D>::fillFreeFormBody() {
   std::vector<Vec<D>> offset;
   std::vector<Mat<D>> spread;
   std::vector<Vec<D>> boundary;  // a_I of the whole boundary (mesh bodies)
+  std::vector<Mat<D>> moment;    // b_I (the linear-stress constraint)
   std::map<std::string, SurfacePatch<D>> surfaces;
   std::map<std::string, std::vector<Index>> volumes;
   std::string what;
@@ -110,7 +111,8 @@ void Builder<D>::fillFreeFormBody() {
       throw r.error("file", e.what());
     }
     if (integrationConstraint_)
-      boundary = boundaryAreaVectors<D>(mesh.position, mesh.cellStart, mesh.cellNode);
+      boundary = boundaryAreaVectors<D>(mesh.position, mesh.cellStart, mesh.cellNode,
+                                        integrationLinear_ ? &moment : nullptr);
     X = std::move(mesh.position);
     V = std::move(mesh.volume);
     offset = std::move(mesh.offset);
@@ -161,6 +163,10 @@ void Builder<D>::fillFreeFormBody() {
     if (!boundary.empty()) {  // the only body: every particle has its a_I
       p.boundaryArea.resize(p.size());
       p.boundaryArea.back() = boundary[i];
+      if (!moment.empty()) {
+        p.boundaryMoment.resize(p.size());
+        p.boundaryMoment.back() = moment[i];
+      }
     }
     setup_.body.push_back(0);
     setup_.ghost.push_back(0);

@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "method/IntegrationConstraint.hpp"
 #include "method/Kernel.hpp"
 #include "method/TimeStep.hpp"
 #include "scene/Builder.hpp"
@@ -37,8 +38,20 @@ void Builder<D>::readDiscretisation() {
                   "quadratic fit)");
   if (setup_.scene.quadrature == Quadrature::Taylor) warnNearlyIncompressible();
   // The gradient vectors corrected so that a uniform stress balances its tractions at every
-  // particle (method/IntegrationConstraint.hpp): needs the boundary of a mesh body.
-  integrationConstraint_ = k.flag("integration_constraint", false);
+  // particle, and with `linear` a linearly varying one too in the filtered sense
+  // (method/IntegrationConstraint.hpp): needs the boundary of a mesh body.
+  const std::string constraint =
+      k.word("integration_constraint", "false",
+             {"false", "true", "uniform", "linear", "no", "yes", "off", "on", "0", "1"});
+  integrationLinear_ = constraint == "linear";
+  integrationConstraint_ =
+      integrationLinear_ || constraint == "uniform" || k.flag("integration_constraint", false);
+  // (Without any constraint the filter is ignored: the multigrid's coarse levels turn the
+  // constraint off and keep the rest of the scene.)
+  if (k.has("integration_filter") && integrationConstraint_ && !integrationLinear_)
+    throw k.error("integration_filter", "applies only with integration_constraint = linear");
+  setup_.scene.integrationFilter =
+      integrationLinear_ ? k.positive("integration_filter", kLinearConstraintFilter) : 0.0;
   k.finish();
   SectionReader h(config_, "hourglass");
   setup_.scene.hourglassCoefficient = h.nonNegative("alpha", 10.0);
