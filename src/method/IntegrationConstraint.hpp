@@ -33,9 +33,9 @@
 // The linear-stress constraint (`integration_constraint = linear`) adds the first moments: for a
 // stress varying linearly in X, equilibrium with its tractions and its divergence at every
 // particle needs, besides d_I = a_I,
-//   m_I = b_I - V_I 1,   m_I = sum_K V_K (X_K - X_I) (x) v_KI,   b_I = int lambda_I (X - X_I) (x) n
-//   dA
-// (geometry/BoundaryArea.hpp). Its correction is again delta_K = Pi_K (A^T mu)_K, now with
+//   m_I = b_I - V_I 1,   m_I = sum_K V_K (X_K - X_I) (x) v_KI,
+//   b_I = int lambda_I (X - X_I) (x) n dA   (geometry/BoundaryArea.hpp).
+// Its correction is again delta_K = Pi_K (A^T mu)_K, now with
 // (A^T mu)_KJ = V_K [(lambda_J - lambda_K) + Lambda_J^T (X_K - X_J)], 1 + D multipliers per
 // particle and component. The operator B = A Pi A^T annihilates a cubic lambda paired with a
 // quadratic Lambda (18 directions per component in 2D, 40 in 3D), and above them it has a
