@@ -29,6 +29,7 @@
 #include "method/ReferenceConfiguration.hpp"
 #include "method/TimeStep.hpp"
 #include "model/Errors.hpp"
+#include "model/RigidModes.hpp"
 #include "model/Scene.hpp"
 
 namespace tlsph {
@@ -255,6 +256,7 @@ class Solver {
 
   // Out-of-balance force of a quasi-static run: |sum over free particles of (f_int + f_ext)|_2
   // relative to the size of the forces that hold the body (external loads and reactions).
+  // A free body's (leaveOutRigidPart): of the residual's deformation part.
   double residualRatio() const {
     requireSynchronized();
     const auto& p = scene_.particles;
@@ -263,10 +265,23 @@ class Solver {
       residual += totalForce(i).squaredNorm();
       if (loads_.any()) reference += loads_.force()[i].squaredNorm();
     }
+    if (rigidLeftOut_) {
+      Eigen::VectorXd r(D * static_cast<Index>(free_.size()));
+      for (std::size_t k = 0; k < free_.size(); ++k)
+        r.template segment<D>(D * k) = totalForce(free_[k]);
+      RigidModes<D> rigid;
+      rigid.update(free_, p.referencePosition, p.displacement);
+      rigid.project(r);
+      residual = r.squaredNorm();
+    }
     for (Index i : prescribed_.particles())
       reference += p.force[i].squaredNorm();
     return reference > 0.0 ? std::sqrt(residual / reference) : std::sqrt(residual);
   }
+
+  // A static solve of a body nothing holds (the Newton solver's): its loads' rigid part, what
+  // is left of their balance, is no deformation's to remove, and residualRatio leaves it out.
+  void leaveOutRigidPart() { rigidLeftOut_ = true; }
 
   long kineticDampingResets() const { return kineticResets_; }
 
@@ -472,6 +487,7 @@ class Solver {
   FallbackSummary fallback_;
   std::vector<double> kineticTerms_;
   std::vector<Vec<D>> prescribedStep_;  // per prescribed particle: its move over this step
+  bool rigidLeftOut_ = false;           // residualRatio of a free body
   ExternalForces<D> loads_;
   StableStep stable_;
   double dt_ = 0.0;

@@ -120,6 +120,7 @@ MultigridPreconditioner<D>::MultigridPreconditioner(const Scene<D>& fine, const 
     above.restriction = above.prolongation.transpose();
     levels_.push_back(std::move(level));
   }
+  if (heldByNothing(*levels_.back()->scene)) coarsestRigid_.emplace();
 }
 
 template <int D>
@@ -160,9 +161,14 @@ bool MultigridPreconditioner<D>::update(double t, const std::vector<Vec<D>>& u, 
     }
     level.lambdaMax = largestEigenvalue(level);
   }
-  const auto& K = levels_.back()->tangent->assemble();
+  const Level& coarsest = *levels_.back();
+  const auto& K = coarsest.tangent->assemble();
   coarsestNonZeros_ = K.nonZeros();
-  if (!factor_.factorise(K)) {
+  if (coarsestRigid_) {
+    const auto& cp = coarsest.scene->particles;
+    coarsestRigid_->update(coarsest.dofs->freeParticles(), cp.referencePosition, cp.displacement);
+  }
+  if (!factor_.factorise(coarsestRigid_ ? shiftDiagonal(K) : K)) {
     why =
         "the coarsest multigrid level's tangent stiffness is not positive definite (a buckling "
         "or material instability, or a body not held against rigid motion)";
@@ -230,7 +236,11 @@ Eigen::VectorXd MultigridPreconditioner<D>::smooth(Level& level, const Eigen::Ve
 
 template <int D>
 Eigen::VectorXd MultigridPreconditioner<D>::cycle(std::size_t l, const Eigen::VectorXd& r) {
-  if (l + 1 == levels_.size()) return factor_.solve(r);
+  if (l + 1 == levels_.size()) {
+    Eigen::VectorXd z = factor_.solve(r);
+    if (coarsestRigid_) coarsestRigid_->project(z);
+    return z;
+  }
   Level& level = *levels_[l];
   Eigen::VectorXd x = smooth(level, r);
   level.apply(x, level.product);

@@ -16,6 +16,7 @@
 
 #include <Eigen/Core>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,7 @@
 #include "implicit/DofMap.hpp"
 #include "implicit/SparseCholesky.hpp"
 #include "implicit/TangentStiffness.hpp"
+#include "model/RigidModes.hpp"
 #include "model/Scene.hpp"
 
 namespace tlsph {
@@ -68,6 +70,9 @@ class MultigridPreconditioner {
 
   std::vector<std::unique_ptr<Level>> levels_;
   SparseCholesky factor_;
+  // A free body's coarsest level: its factor is of the shifted matrix, its solution projected
+  // off the rigid motions (RigidModes.hpp).
+  std::optional<RigidModes<D>> coarsestRigid_;
   long coarsestNonZeros_ = 0;
 };
 

@@ -66,6 +66,10 @@ NewtonSolver<D>::NewtonSolver(Scene<D>& scene, Solver<D>& solver, const NewtonSe
       }
     }
   }
+  if (heldByNothing(scene)) {
+    rigid_.emplace();
+    solver.leaveOutRigidPart();
+  }
   for (const auto& load : scene.loads)
     following_ = following_ || load.following.has_value();
   if (following_) {
@@ -191,6 +195,18 @@ void NewtonSolver<D>::residual(Eigen::VectorXd& r) const {
 }
 
 template <int D>
+double NewtonSolver<D>::balanceRatio(Eigen::VectorXd& r) {
+  if (rigid_) {
+    rigid_->update(dofs_.freeParticles(), scene_.particles.referencePosition,
+                   scene_.particles.displacement);
+    rigid_->project(r);
+  }
+  const double ratio = solver_.residualRatio();  // of the projected residual for a free body
+  referenceForce_ = ratio > 0.0 ? r.norm() / ratio : r.norm();
+  return ratio;
+}
+
+template <int D>
 double NewtonSolver<D>::displacementNorm() const {
   double s = 0.0;
   for (Index i : dofs_.freeParticles())
@@ -238,7 +254,7 @@ bool NewtonSolver<D>::factorise(std::string& why) {
   statistics_.nonZeros = K.nonZeros();
   statistics_.assemblySeconds += seconds(t0);
   t0 = Clock::now();
-  factorised_ = factor_.factorise(K);
+  factorised_ = factor_.factorise(rigid_ ? shiftDiagonal(K) : K);
   const auto& F = solver_.forces().deformationGradient();
   factorDeformation_.assign(F.begin(), F.end());
   statistics_.factorisationSeconds += seconds(t0);
@@ -274,8 +290,7 @@ template <int D>
 bool NewtonSolver<D>::solveLinear(const Eigen::VectorXd& r, Eigen::VectorXd& du, std::string& why) {
   const auto t0 = Clock::now();
   // Relative to r, but no tighter than the Newton tolerance needs (r may be at round-off).
-  const double ratio = solver_.residualRatio();
-  const double forceScale = ratio > 0.0 ? r.norm() / ratio : r.norm();
+  const double forceScale = referenceForce_;
   const double target =
       std::max(settings_.linearTolerance * r.norm(), 0.1 * settings_.tolerance * forceScale);
   du = precondition(r);
@@ -325,7 +340,8 @@ bool NewtonSolver<D>::solveAt(double t, std::string& why) {
   Eigen::VectorXd r, du, rTrial;
   history_.clear();
   for (int it = 0; it < settings_.maxIterations; ++it) {
-    const double ratio = solver_.residualRatio();
+    residual(r);
+    const double ratio = balanceRatio(r);
     history_.push_back(ratio);
     if (!std::isfinite(ratio)) {
       why = "the residual is not finite (an inverted particle?)";
@@ -334,7 +350,6 @@ bool NewtonSolver<D>::solveAt(double t, std::string& why) {
     if (it > 0 && ratio <= settings_.tolerance &&
         lastStep_ <= settings_.displacementTolerance * std::max(displacementNorm(), 1e-300))
       return true;
-    residual(r);
     // The exact tangent at the present state for the product; the factorised matrix, only a
     // preconditioner, is renewed when it has gone stale (too many conjugate-gradient iterations).
     tangent_.update(solver_.forces().deformationGradient());
@@ -357,6 +372,7 @@ bool NewtonSolver<D>::solveAt(double t, std::string& why) {
     for (int halvings = 0;; ++halvings) {
       move(du, s);
       residual(rTrial);
+      if (rigid_) rigid_->project(rTrial);
       const double r1 = rTrial.norm();
       if ((std::isfinite(r1) && r1 < (1.0 - 1e-4 * s) * r0) || halvings == 8) break;
       move(du, -0.5 * s);
@@ -365,8 +381,9 @@ bool NewtonSolver<D>::solveAt(double t, std::string& why) {
     lastStep_ = s * du.norm();
   }
   std::ostringstream msg;
+  residual(r);
   msg << "not converged in " << settings_.maxIterations << " iterations (out-of-balance ratio "
-      << solver_.residualRatio() << ", target " << settings_.tolerance << ")";
+      << balanceRatio(r) << ", target " << settings_.tolerance << ")";
   why = msg.str();
   return false;
 }

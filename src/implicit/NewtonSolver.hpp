@@ -15,6 +15,7 @@
 #include <cmath>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <sstream>
 #include <stdexcept>
@@ -27,6 +28,7 @@
 #include "implicit/SparseCholesky.hpp"
 #include "implicit/TangentStiffness.hpp"
 #include "model/Errors.hpp"
+#include "model/RigidModes.hpp"
 
 namespace tlsph {
 
@@ -135,6 +137,8 @@ class NewtonSolver {
 
   // Residual on the unknowns: the net force on each free particle.
   void residual(Eigen::VectorXd& r) const;
+  // Solver::residualRatio; a free body's residual r is first projected off the rigid motions.
+  double balanceRatio(Eigen::VectorXd& r);
   double displacementNorm() const;
   void move(const Eigen::VectorXd& du, double s);
   bool factorise(std::string& why);
@@ -145,7 +149,9 @@ class NewtonSolver {
                        const std::vector<typename TaylorQuadrature<D>::SymMatrix>& G,
                        std::string& why);
   Eigen::VectorXd precondition(const Eigen::VectorXd& r) {
-    return multigrid_ ? multigrid_->apply(r) : factor_.solve(r);
+    Eigen::VectorXd z = multigrid_ ? multigrid_->apply(r) : factor_.solve(r);
+    if (rigid_) rigid_->project(z);
+    return z;
   }
   // Preconditioned conjugate gradients on the exact K (BiCGSTAB with a following pressure);
   // false on negative curvature, a breakdown or a stall.
@@ -163,6 +169,9 @@ class NewtonSolver {
   TangentStiffness<D> tangent_;
   SparseCholesky factor_;
   std::unique_ptr<MultigridPreconditioner<D>> multigrid_;  // instead of factor_ when set
+  // A body nothing holds (its loads balance): the corrections are kept off its rigid motions.
+  std::optional<RigidModes<D>> rigid_;
+  double referenceForce_ = 0.0;  // the loads' size in the last balanceRatio (its denominator)
   // Conjugate-gradient iterations: the most per solve, and how many make the preconditioner stale.
   static constexpr int kMaxKrylov = 500;
   static constexpr int kRefactorAfter = 25;

@@ -103,6 +103,7 @@ class Builder {
   // (NumericsSections.cpp).
   void readDiscretisation();
   void readTimeAndDamping();
+  void checkFreeBodyLoads(bool newton);
 
   // [body.NAME], [hole.NAME], [region.NAME] and the lattice they make (BodySections.cpp).
   void fillBodies();

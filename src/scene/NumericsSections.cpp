@@ -1,15 +1,21 @@
 // How the scene is solved: [kernel], [hourglass], [artificial_viscosity], [damping], [static]
 // and [time].
 #include <algorithm>
+#include <map>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
 #include "method/IntegrationConstraint.hpp"
 #include "method/Kernel.hpp"
 #include "method/TimeStep.hpp"
+#include "model/RigidModes.hpp"
 #include "scene/Builder.hpp"
 
 namespace tlsph::scene_build {
+
+// The largest rigid part of the loads of a body nothing holds, per unit of their size.
+constexpr double kFreeBodyBalance = 1e-3;
 
 template <int D>
 void Builder<D>::readDiscretisation() {
@@ -118,15 +124,89 @@ void Builder<D>::readTimeAndDamping() {
                        "a static run needs damping: set [damping] kinetic = true or viscous > 0, "
                        "or solve it with [static] solver = newton");
     if (setup_.scene.prescriptions.empty() && setup_.scene.mirrorGhosts.empty())
-      throw InputError(config_.where("static", "enabled"), "static", "enabled",
-                       "a static run needs the body held: add a [clamp.NAME] or a "
-                       "[prescribe.NAME] section, or it drifts away under its loads");
+      checkFreeBodyLoads(newton);
   }
+}
+
+// A static run of bodies nothing holds is determined up to a rigid motion, and has a solution
+// only when the loads balance: no gravity, and the loads that ramp together (the same ramp
+// time) with no rigid part, |Q^T f| / |f| with Q the rigid motions (model/RigidModes.hpp).
+// A pressure on a closed curved surface leaves a rigid part of the surface's discretisation
+// error (its area vectors follow the true surface); the Newton solver leaves that out, so a
+// limit far above it and far below any real imbalance tells the two apart.
+template <int D>
+void Builder<D>::checkFreeBodyLoads(bool newton) {
+  const auto& p = setup_.scene.particles;
+  const std::string hold =
+      "add a [clamp.NAME] or a [prescribe.NAME] section, or it drifts away under its loads";
+  if (!newton)
+    throw InputError(config_.where("static", "enabled"), "static", "enabled",
+                     "a static run needs the body held: nothing holds it; " + hold +
+                         " (solver = newton solves a body nothing holds if its loads balance)");
+  if (!setup_.scene.gravity.isZero())
+    throw InputError(config_.where("static", "enabled"), "static", "enabled",
+                     "a static run needs the body held: nothing holds it, and gravity has no "
+                     "load to balance it; " +
+                         hold);
+  if (setup_.scene.loads.empty())
+    throw InputError(config_.where("static", "enabled"), "static", "enabled",
+                     "a static run needs the body held: nothing holds it and no load acts "
+                     "on it; " +
+                         hold);
+  std::vector<Index> all(p.size());
+  for (Index i = 0; i < p.size(); ++i)
+    all[i] = i;
+  RigidModes<D> rigid;
+  rigid.update(all, p.referencePosition, std::vector<Vec<D>>(p.size(), Vec<D>::Zero()));
+  struct Group {
+    Eigen::VectorXd force;
+    std::string names;
+  };
+  std::map<double, Group> byRamp;
+  const std::vector<Vec<D>> still(p.size(), Vec<D>::Zero());
+  for (const auto& load : setup_.scene.loads) {
+    std::vector<Vec<D>> f(p.size(), Vec<D>::Zero());
+    if (load.following) {
+      load.following->addForce(p.referencePosition, still, 1.0, f);
+    } else {
+      for (std::size_t k = 0; k < load.particles.size(); ++k)
+        f[load.particles[k]] += load.force[k];
+    }
+    Group& g = byRamp[load.ramp.duration];
+    if (g.force.size() == 0) g.force = Eigen::VectorXd::Zero(D * p.size());
+    g.names += (g.names.empty() ? "" : ", ") + load.name;
+    for (Index i = 0; i < p.size(); ++i)
+      g.force.template segment<D>(D * i) += f[i];
+  }
+  double worst = 0.0;
+  for (const auto& [ramp, g] : byRamp) {
+    const double imbalance = rigid.rigidPart(g.force) / g.force.norm();
+    worst = std::max(worst, imbalance);
+    if (imbalance <= kFreeBodyBalance) continue;
+    Vec<D> net = Vec<D>::Zero();
+    for (Index i = 0; i < p.size(); ++i)
+      net += g.force.template segment<D>(D * i);
+    std::ostringstream msg;
+    msg << "a static run needs the body held: nothing holds it, and its loads do not balance ("
+        << g.names << (byRamp.size() > 1 ? ", the loads with this ramp time" : "")
+        << "): their resultant force is " << fmt<D>(net) << " N, and their rigid part " << imbalance
+        << " of their size (at most " << kFreeBodyBalance << " for a body nothing "
+        << "holds); " << hold;
+    const std::string first = g.names.substr(0, g.names.find(','));
+    throw InputError(config_.where(first, "type"), first, "type", msg.str());
+  }
+  std::ostringstream line;
+  line << "free body: nothing holds the bodies; their loads balance to " << worst
+       << " of their size (that rigid part is left out): the static solution is found up to a "
+          "rigid motion and reported with none (zero mean translation and rotation)";
+  setup_.conditions.push_back(line.str());
 }
 
 template void Builder<2>::readDiscretisation();
 template void Builder<2>::readTimeAndDamping();
+template void Builder<2>::checkFreeBodyLoads(bool);
 template void Builder<3>::readDiscretisation();
 template void Builder<3>::readTimeAndDamping();
+template void Builder<3>::checkFreeBodyLoads(bool);
 
 }  // namespace tlsph::scene_build
