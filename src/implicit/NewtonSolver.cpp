@@ -296,15 +296,24 @@ bool NewtonSolver<D>::solveLinear(const Eigen::VectorXd& r, Eigen::VectorXd& du,
   du = precondition(r);
   ConjugateGradientResult cg;
   if (following_) {
-    const BiCgStabResult b =
-        biCgStab([&](const Eigen::VectorXd& v, Eigen::VectorXd& Kv) { applyTangent(v, Kv); },
-                 [&](const Eigen::VectorXd& v) { return precondition(v); }, r, du, target,
-                 kMaxKrylov, kStall);
+    const BiCgStabResult b = biCgStab(
+        [&](const Eigen::VectorXd& v, Eigen::VectorXd& Kv) {
+          applyTangent(v, Kv);
+          if (rigid_) rigid_->project(Kv);
+        },
+        [&](const Eigen::VectorXd& v) { return precondition(v); }, r, du, target, kMaxKrylov,
+        kStall);
     cg.iterations = b.iterations;
     cg.residual = b.residual;
   } else {
     cg = conjugateGradients(
-        [&](const Eigen::VectorXd& v, Eigen::VectorXd& Kv) { tangent_.apply(v, Kv); },
+        [&](const Eigen::VectorXd& v, Eigen::VectorXd& Kv) {
+          tangent_.apply(v, Kv);
+          // A free body: the conjugate gradients run on (1 - Q Q^T) K. K is only nearly
+          // singular along Q (rotations about the present positions), and the rigid part of
+          // K v would sit in the residual out of the projected corrections' reach.
+          if (rigid_) rigid_->project(Kv);
+        },
         [&](const Eigen::VectorXd& v) { return precondition(v); }, r, du, target, kMaxKrylov,
         kStall);
   }
