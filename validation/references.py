@@ -296,7 +296,8 @@ def kirchhoff_plate_deflection(E, nu, t, a, q, coefficient=0.00126):
 
 
 # --------------------------------------------------------------------------------------------
-# Thick-walled cylinder (Lame), plane strain
+# Thick-walled cylinder (Lame): plane strain with the outer surface clamped; the textbook case
+# with it free (plane strain, and plane stress: the open-ended cylinder)
 
 
 def lame_ring(E, nu, a, b, p):
@@ -312,6 +313,29 @@ def lame_ring(E, nu, a, b, p):
         return (A * r + B / r, 2.0 * (lam + mu) * A - 2.0 * mu * B / r**2,
                 2.0 * (lam + mu) * A + 2.0 * mu * B / r**2)
     return at
+
+
+def lame_free(E, nu, a, b, p, plane_strain=True):
+    """The textbook Lame problem: a <= r <= b under internal pressure p, the outer surface free
+    (sigma_rr(a) = -p, sigma_rr(b) = 0). With k = p a^2 / (b^2 - a^2): sigma_rr = k (1 - b^2/r^2),
+    sigma_tt = k (1 + b^2/r^2) in both cases; plane strain: u_r = (1 + nu)/E k ((1 - 2 nu) r +
+    b^2/r); plane stress (sigma_zz = 0: the open-ended cylinder of any length, exact in 3D, its
+    axial strain -2 nu k / E uniform): u_r = k/E ((1 - nu) r + (1 + nu) b^2/r). Returns a
+    function r -> (u_r, sigma_rr, sigma_tt)."""
+    k = p * a**2 / (b**2 - a**2)
+
+    def at(r):
+        if plane_strain:
+            u = (1.0 + nu) / E * k * ((1.0 - 2.0 * nu) * r + b**2 / r)
+        else:
+            u = k / E * ((1.0 - nu) * r + (1.0 + nu) * b**2 / r)
+        return u, k * (1.0 - b**2 / r**2), k * (1.0 + b**2 / r**2)
+    return at
+
+
+def lame_free_axial_strain(E, nu, a, b, p):
+    """The open-ended cylinder's uniform axial strain (plane stress Lame): -2 nu k / E."""
+    return -2.0 * nu * p * a**2 / (b**2 - a**2) / E
 
 
 if __name__ == "__main__":
@@ -345,3 +369,9 @@ if __name__ == "__main__":
     print("Lame ring: u(a) = %.5e m, u(0.075) = %.5e m, sigma_rr(a) = %.5e Pa, "
           "sigma_tt(a) = %.5e Pa" % (ring(0.05)[0], ring(0.075)[0], ring(0.05)[1],
                                      ring(0.05)[2]))
+    for ps in (True, False):
+        free = lame_free(2.0e11, 0.3, 0.05, 0.1, 1.0e8, plane_strain=ps)
+        print("Lame free (%s): u(a) = %.6e m, sigma_rr(a) = %.6e Pa, sigma_tt(a) = %.6e Pa, "
+              "sigma_tt(b) = %.6e Pa" % ("plane strain" if ps else "plane stress, open ends",
+                                         free(0.05)[0], free(0.05)[1], free(0.05)[2],
+                                         free(0.1)[2]))

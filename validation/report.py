@@ -309,6 +309,34 @@ COLUMNS = {
 COLUMNS["cook_membrane_incompressible"] = COLUMNS["cook_membrane"]
 
 
+def _lame_free_columns(at, extra, u="u"):
+    """The free (textbook) Lame problems: the 32 bore nodes' mean and worst, then `extra`,
+    then the Newton run's peak memory (these problems have no damped twin, so no solver
+    table)."""
+    return [
+        ("mean %s%s [mm]" % (u, at), _mm("u_a", 6)),
+        ("its error %", lambda r: err(r, "u_a")),
+        ("worst node's abs. error %", lambda r: f3((r.get("qoi") or {}).get("errors", {})
+                                                    .get("u_a_worst"), 2)),
+        ("mean sigma_tt%s recovered [MPa]" % at, lambda r: f3(val(r, "stt_s") / 1e6
+                                                              if val(r, "stt_s") is not None
+                                                              else None, 2)),
+        ("its error %", lambda r: err(r, "stt_s")),
+        ("worst node's abs. error %", lambda r: f3((r.get("qoi") or {}).get("errors", {})
+                                                    .get("stt_s_worst"), 2)),
+        ("sigma_rr%s recovered error %%" % at, lambda r: err(r, "srr_s")),
+    ] + extra + [
+        ("largest particle-probe angle [deg]", lambda r: f3(val(r, "angle_offset_max_deg"),
+                                                            2)),
+        ("Newton peak memory", lambda r: mem(r.get("peak_rss_mb"))),
+    ]
+
+
+COLUMNS["lame_ring_free"] = _lame_free_columns("(a)", [])
+COLUMNS["lame_cylinder_free"] = _lame_free_columns(
+    "(a, L/2)", [("u_r(a, 0) error %", lambda r: err(r, "u_end"))], "u_r")
+
+
 def _s(x):
     return None if x is None else x * MM
 
@@ -343,6 +371,11 @@ CONVERGENCE = {
     "plate_hole_fitted": [("kt_top", "kt_top", "FEM"), ("end_ux", "end_ux", "FEM"),
                           ("kt_top_kernel", "kt_top_kernel", "FEM")],
     "bracket": [("ux_P", "ux_P", "FEM"), ("uz_P", "uz_P", "FEM")],
+    "lame_ring_free": [("stt_s_worst", None, "Lame"), ("u_a", "u_a", "Lame"),
+                       ("stt_s", "stt_s", "Lame"), ("u_a_worst", None, "Lame")],
+    "lame_cylinder_free": [("stt_s_worst", None, "Lame"), ("u_a", "u_a", "Lame"),
+                           ("stt_s", "stt_s", "Lame"), ("u_a_worst", None, "Lame"),
+                           ("u_end", "u_end", "Lame")],
 }
 # Secondary errors shown in the summary (label, error name).
 SUMMARY_EXTRA = {
@@ -363,6 +396,10 @@ SUMMARY_EXTRA = {
     "lame_cylinder": [("sigma_tt(a, L/2) vs FEM", "stt_a"), ("recovered", "stt_s")],
     "plate_hole_fitted": [("end u_x vs FEM", "end_ux")],
     "bracket": [("u_z(P) vs FEM", "uz_P")],
+    "lame_ring_free": [("mean u(a)", "u_a"), ("worst node's u(a), abs.", "u_a_worst"),
+                       ("mean sigma_tt(a)", "stt_s")],
+    "lame_cylinder_free": [("mean u_r(a)", "u_a"), ("worst node's u_r(a), abs.", "u_a_worst"),
+                           ("mean sigma_tt(a)", "stt_s"), ("u_r(a, 0)", "u_end")],
 }
 # The quantity an error is of, for legends and tables.
 ERROR_SYMBOL = {"period": "T", "period_vs_timoshenko": "T", "tip": "w", "tip_vs_fem": "w",
@@ -375,7 +412,8 @@ ERROR_SYMBOL = {"period": "T", "period_vs_timoshenko": "T", "tip": "w", "tip_vs_
                 "corner_ux": "corner u_x", "edge_mid_uy": "mid-edge u_y", "end_ux": "end u_x",
                 "kt_top": "Kt (probe)", "kt_top_vs_peterson": "Kt (probe)",
                 "u_a": "u(a)", "stt_a": "sigma_tt(a)", "kt_top_kernel": "Kt (kernel probe)",
-                "ux_P": "u_x(P)", "uz_P": "u_z(P)"}
+                "ux_P": "u_x(P)", "uz_P": "u_z(P)",
+                "stt_s_worst": "worst-node sigma_tt(a)", "u_a_worst": "worst-node u(a)"}
 
 
 # Errors of displacement components taken along the reference's direction (run.py
@@ -389,7 +427,7 @@ PRIMARY_AGAINST = {"oscillating_plate": "thin plate", "cantilever_static": "FEM"
                    "cook_membrane": "FEM", "cook_membrane_incompressible": "FEM",
                    "plate_hole": "FEM", "lame_ring": "Lame", "lame_cylinder": "FEM",
                    "plate_hole_fitted": "FEM",
-                   "bracket": "FEM"}
+                   "bracket": "FEM", "lame_ring_free": "Lame", "lame_cylinder_free": "Lame"}
 
 
 def error_label(name, against):
@@ -432,6 +470,11 @@ def reference_value(R, key, error_name):
         ("lame_cylinder", "stt_s"): R.get("lame_cylinder", {}).get("stt_a"),
         ("lame_cylinder", "u_end"): R.get("lame_cylinder", {}).get("u_end"),
         ("bracket", "ux_P"): R.get("bracket", {}).get("ux_P"),
+        ("lame_ring_free", "u_a"): R.get("lame_ring_free", {}).get("u_a"),
+        ("lame_ring_free", "stt_s"): R.get("lame_ring_free", {}).get("stt_a"),
+        ("lame_cylinder_free", "u_a"): R.get("lame_cylinder_free", {}).get("u_a"),
+        ("lame_cylinder_free", "stt_s"): R.get("lame_cylinder_free", {}).get("stt_a"),
+        ("lame_cylinder_free", "u_end"): R.get("lame_cylinder_free", {}).get("u_end"),
         ("bracket", "uz_P"): R.get("bracket", {}).get("uz_P"),
     })
     for case in ("cook_membrane", "cook_membrane_incompressible"):
@@ -492,11 +535,15 @@ def extra_error(r, name):
     return None if e is None else e
 
 
-def twin_cell(runs, r):
+def twin_cell(runs, r, p=None):
     """The summary's last column: at the finest resolution of a static problem, the solver of
-    the primary run and the twin's wall time (the other solver), with Newton's speed-up."""
+    the primary run and the twin's wall time (the other solver), with Newton's speed-up; for
+    a problem that has no twins (p's newton.no_twin) the reason."""
     if not r.get("solver"):
         return "-"
+    why = ((p or {}).get("newton") or {}).get("no_twin")
+    if why:
+        return "%s; no twin (%s)" % (r["solver"], why)
     other = "damped" if r["solver"] == "newton" else "newton"
     t = counterpart(runs, r, other)
     if t is None:
@@ -511,6 +558,35 @@ def twin_cell(runs, r):
     d, n = (r, t) if r["solver"] == "damped" else (t, r)
     return "%s; %s %.1f (Newton %s)" % (r["solver"], other, t["wall_seconds"],
                                        x_text(speedup(d, n)))
+
+
+def target_at_text(p, variant, lad, tgt):
+    """The summary's 'met' cell of a problem whose target is held at one resolution of one
+    variant (p["target_at"]): every named error within tgt[1] % there."""
+    ta = p["target_at"]
+    n, tv = ta["per_thickness"], ta.get("variant", "")
+    if variant != tv:
+        return "- (the target is for %s)" % variant_label(p, tv)
+    r = next((x for x in lad if x["per_thickness"] == n), None)
+    names = [tgt[0]] + list(ta.get("errors") or [])
+    es = [((r or {}).get("qoi") or {}).get("errors", {}).get(k) for k in names]
+    if r is None or None in es:
+        return "not run at %d through" % n
+    ok = all(abs(x) <= tgt[1] for x in es) and not r.get("energy_growth")
+    return "%s (at %d through: %s)" % ("yes" if ok else "**no**", n, ", ".join(
+        "%s %s" % (k, f3(x, 2, signed=k != tgt[0])) for k, x in zip(names, es)))
+
+
+def target_lines(p, runs, key):
+    """A problem section's statement of a target held at one resolution of one variant."""
+    ta, tgt = p.get("target_at"), p.get("target")
+    if not ta or not tgt:
+        return []
+    tv = ta.get("variant", "")
+    names = [tgt[0]] + list(ta.get("errors") or [])
+    return ["**Target**: %s within %g %% at %d through (%s): %s." % (
+        " and ".join("`%s`" % k for k in names), tgt[1], ta["per_thickness"],
+        variant_label(p, tv), target_at_text(p, tv, ladder(runs, key, tv), tgt)), ""]
 
 
 def readme(data, plots, plot_note):
@@ -620,7 +696,9 @@ def readme(data, plots, plot_note):
         e = primary_error(fin)
         tgt = p.get("target")
         met = "-"
-        if tgt and e is not None:
+        if tgt and p.get("target_at"):
+            met = target_at_text(p, variant, lad, tgt)
+        elif tgt and e is not None:
             met = "yes" if abs(e) <= tgt[1] and not fin.get("energy_growth") else "**no**"
             if fin["dx"] > min(p["ladder"]) + 1e-12:
                 met = "- (%s; the target is for %d per thickness)" % (
@@ -640,7 +718,7 @@ def readme(data, plots, plot_note):
                      err(fin, q.get("primary", "")) if q else outcome(fin),
                      extra or "-",
                      "%s %%" % tgt[1] if tgt else "-", met, o,
-                     "%.1f" % (fin.get("wall_seconds") or 0), twin_cell(runs, fin)])
+                     "%.1f" % (fin.get("wall_seconds") or 0), twin_cell(runs, fin, p)])
     L += table(["problem", "quantity (error)", "finest: per thickness / dx", "error %",
                 "other errors at the finest, %", "target", "met", "order (last pair)",
                 "wall s", "static: solver; twin's wall s"], rows)
@@ -969,6 +1047,15 @@ def solvers_section(P, runs, meta):
                  "Newton for %s" % ", ".join(newton_first) if newton_first else
                  "the damped solver", factor, budget))
     L.append("")
+    alone = [short_title(k, p) for k, p in P.items()
+             if ((p.get("newton") or {}).get("no_twin"))]
+    if alone:
+        L.append("Not in this section: %s (%s); their Newton runs' wall time and peak "
+                 "memory are in their own sections." % (
+                     "; ".join(alone), next((p.get("newton") or {})["no_twin"]
+                                            for p in P.values()
+                                            if (p.get("newton") or {}).get("no_twin"))))
+        L.append("")
     rows = []
     for key, p in static:
         for variant in p["variants"]:
@@ -1235,6 +1322,22 @@ def references_section(R):
                  "u_r(a, 0) = %.6e m; a C3D10 model of the same gmsh geometry agrees to "
                  "4e-4 (validation/lame_cylinder_fem.py, lame_cylinder_fem.json)." % (
                      lc["u_a"], lc["stt_a"], lc["srr_a"], lc["u_end"]))
+    lf, cf = R.get("lame_ring_free"), R.get("lame_cylinder_free")
+    if lf:
+        L.append("- **Free Lame ring and cylinder** (`lame_ring_free.ini`, "
+                 "`lame_cylinder_free.ini`): the textbook problem, the same ring and "
+                 "cylinder with the outer surface free and nothing holding them (free "
+                 "bodies; validation/references.py `lame_free`): k = p a^2/(b^2 - a^2), "
+                 "sigma_rr = k (1 - b^2/r^2), sigma_tt = k (1 + b^2/r^2): sigma_tt(a) = "
+                 "**%.6e Pa** (5/3 p), sigma_rr(a) = %.4e Pa, sigma_tt(b) = %.4e Pa. Ring, "
+                 "plane strain: u_r = (1 + nu)/E k ((1 - 2 nu) r + b^2/r), u(a) = **%.6e m**.%s"
+                 " The same at every point of the bore: each of the 32 bore nodes is compared "
+                 "with it." % (
+                     lf["stt_a"], lf["srr_a"], lf["stt_b"], lf["u_a"],
+                     (" Cylinder, open ends (sigma_zz = 0, the plane-stress field exact in "
+                      "3D, uniform axial strain %.4e): u_r = k/E ((1 - nu) r + (1 + nu) "
+                      "b^2/r), u_r(a) = **%.6e m** at every z, the ends included." % (
+                          cf["axial_strain"], cf["u_a"])) if cf else ""))
     if R.get("plate_hole_fitted") and ph:
         L.append("- **Plate with a hole, fitted** (`plate_hole_fitted.ini`): the same FEM "
                  "references as the plate with a hole (Kt = %.4f, u_x(0.4, 0.05) = %.5f mm)."
@@ -1333,6 +1436,29 @@ NOTES.update({
                          "each node's share of the edge. Kt from the node at the hole's "
                          "top (nearest-particle probe, the particle's own stress); the kernel "
                          "probe's smoothed Kt for comparison with `plate_hole`.",
+    "lame_ring_free": "The textbook Lame problem: the ring of `lame_ring.ini` (the same gmsh "
+                      "body, material and bore pressure) with its outer surface free and "
+                      "nothing holding it: a free body, which `[static] solver = newton` "
+                      "solves leaving the rigid motions out (the displacement reported with "
+                      "zero mean translation and rotation); the damped solver refuses it, so "
+                      "there is no damped twin. 32 bore points every 11.25 degrees: u_r of "
+                      "the nearest particle and the hoop stress recovered at the nearest bore "
+                      "particle (surface probes, docs/method.md section 3.5), both at the "
+                      "particle's own polar angle (that of its displacement, radial in the "
+                      "exact solution; the particles sit up to half their spacing off the "
+                      "probe points). 'mean' = the 32 nodes' mean, 'worst node' = the "
+                      "largest |error| of the 32: the headline, node by node. sigma_rr "
+                      "recovered = -p by construction (its normal part is the bore's "
+                      "traction). 'Per thickness' = elements through the wall (0.05 m).",
+    "lame_cylinder_free": "The textbook Lame problem in 3D: the open-ended cylinder of "
+                          "`lame_cylinder.ini` (the same gmsh body) with its outer surface "
+                          "and ends free and nothing holding it (a free body: Newton only, "
+                          "no damped twin). With open ends the plane-stress Lame field is "
+                          "exact in 3D, so u_r(a) and sigma_tt(a) are the same everywhere on "
+                          "the bore, the ends included. 32 bore points at mid-length as in "
+                          "the 2D ring (nearest particle's u_r, hoop stress recovered at the "
+                          "nearest bore particle, each at the particle's own polar angle); "
+                          "u_r(a, 0) = u_x of the particle at (a, 0, 0) on the free end.",
     "bracket": "The L-bracket of examples/bracket.ini (3D, gmsh tetrahedra from CAD, "
                "particles = corner nodes; nodal clamp on the bore, pressure on the arm's "
                "face). 'Per thickness' = elements through the 10 mm walls (dx = 5, 3.5, "
@@ -1343,6 +1469,7 @@ NOTES.update({
 
 def problem_section(key, p, runs, R):
     L = ["## %s" % p["title"], "", "Scene `%s`. %s" % (p["scene"], NOTES.get(key, "")), ""]
+    L += target_lines(p, runs, key)
     variants = p["variants"]
     for variant in variants:
         lad = ladder(runs, key, variant)
@@ -1742,6 +1869,13 @@ def plot_variants(p):
     return [v for v in p["variants"] if not v.startswith("alpha")]
 
 
+def legend_variant(p, variant):
+    """A variant in a plot legend: its settings, or its name (the run id's part: 'ic-s2.5')
+    where the settings are too long for a legend."""
+    label = variant_label(p, variant)
+    return variant if variant and len(label) > 24 else label
+
+
 def short_title(key, p):
     t = p["title"].split(",")[0].split(" (")[0]
     return t + (" (nu = 0.4999)" if key == "cook_membrane_incompressible" else "")
@@ -1919,7 +2053,7 @@ def make_plots(data, report_dir):
                 ls = (":" if k else "-") if j == 0 else "--"
                 ax.loglog(h, e, ls, color=colour,
                           label="%s%s: %s" % (error_label(name, against),
-                                              (" " + variant_label(p, variant))
+                                              (" " + legend_variant(p, variant))
                                               if len(plot_variants(p)) > 1 else "",
                                               slope))
                 marker = "o^sD"[(2 * k + j) % 4]
@@ -1957,7 +2091,9 @@ def make_plots(data, report_dir):
                 "plate, u_x for the large-deflection cantilever and Cook's membranes, the "
                 "probe's Kt for the plate with a hole); for CSM1 the vector error and u_y. At "
                 "the defaults; the cantilevers' alpha variants are in the alpha-spread "
-                "table."))
+                "table. The Lame problems' variants are named by their run ids (ic = "
+                "integration_constraint true, lin = linear, s2.5 = support 2.5); the free "
+                "Lame problems' headline is the largest |error| of the 32 bore nodes."))
 
     # 3. time histories
     def hist_runs(key, variant=None):

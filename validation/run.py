@@ -33,14 +33,16 @@ result to report, not a failure of the runner.
 Static problems are solved twice at every ladder resolution: with the scene's solver (the
 primary run; the static scenes say `[static] solver = newton`) and again with the other solver
 (a "twin": `--static.solver=damped`, id `<ladder id>-damped`; record fields `solver`, `twin`,
-`twin_of`). Their sensitivity studies keep the damped solver (`--static.solver=damped`: the
-time.cfl study is about the damped dynamics). A Newton run (primary or twin) is skipped, and
-recorded as skipped, when its predicted peak memory exceeds --newton-memory-gb (default 10 GB;
-the memory model NEWTON_MEMORY below, measured with the multigrid preconditioner). Each twin's
-result must agree with its primary: the relative difference of the problem's headline values
-below NEWTON_AGREEMENT times the static tolerance (--check enforces it; the quick check runs a
-few small twins). Every run's peak resident memory is measured (wait4's ru_maxrss), and a run
-above --memory-limit-gb is stopped.
+`twin_of`); not the free Lame bodies, which nothing holds: the damped solver refuses them
+(Problem no_twin), so they are Newton runs only. Their sensitivity studies keep the damped
+solver (`--static.solver=damped`: the time.cfl study is about the damped dynamics). A Newton
+run (primary or twin) is skipped, and recorded as skipped, when its predicted peak memory
+exceeds --newton-memory-gb (default 10 GB; the memory model NEWTON_MEMORY below, measured
+with the multigrid preconditioner). Each twin's result must agree with its primary: the
+relative difference of the problem's headline values below NEWTON_AGREEMENT times the static
+tolerance (--check enforces it; the quick check runs a few small twins). Every run's peak
+resident memory is measured (wait4's ru_maxrss), and a run above --memory-limit-gb is
+stopped.
 
 Running, parsing and checking use the Python standard library only (CI has no numpy).
 """
@@ -254,6 +256,20 @@ def compute_references(fem_path=FEM_JSON):
     r["lame_cylinder"] = {"u_a": cy["ur_mid"]["value"], "stt_a": cy["stt_mid"]["value"],
                           "srr_a": cy["srr_mid"]["value"], "u_end": cy["ur_end"]["value"],
                           "source": rel(LAME_CYLINDER_FEM_JSON) + ": CAX8 ladder, Richardson"}
+    # The textbook Lame problem: the same ring and cylinder with the outer surface free and
+    # nothing holding them (free bodies: Newton leaves the rigid motions out). Closed form;
+    # open ends make the 3D cylinder's plane-stress field exact (sigma_zz = 0).
+    for key, ps in (("lame_ring_free", True), ("lame_cylinder_free", False)):
+        free = refs.lame_free(2.0e11, 0.3, 0.05, 0.1, 1.0e8, plane_strain=ps)
+        r[key] = {"u_a": free(0.05)[0], "srr_a": free(0.05)[1], "stt_a": free(0.05)[2],
+                  "stt_b": free(0.1)[2], "pressure": 1.0e8,
+                  "source": "Lame, outer surface free: k = p a^2/(b^2 - a^2), sigma_tt = "
+                            "k (1 + b^2/r^2), u_r = " +
+                            ("(1 + nu)/E k ((1 - 2 nu) r + b^2/r) (plane strain)" if ps else
+                             "k/E ((1 - nu) r + (1 + nu) b^2/r) (plane stress, open ends)")}
+    r["lame_cylinder_free"]["u_end"] = r["lame_cylinder_free"]["u_a"]  # the same at the ends
+    r["lame_cylinder_free"]["axial_strain"] = refs.lame_free_axial_strain(2.0e11, 0.3, 0.05,
+                                                                          0.1, 1.0e8)
     # L-bracket: CalculiX C3D10, graded mesh ladder (validation/bracket_fem.py).
     br = json.loads(BRACKET_FEM_JSON.read_text())["reference"]
     r["bracket"] = {k: br[k]["reference"] for k in ("ux_P", "uz_P")}
@@ -617,6 +633,69 @@ def extract_lame_cylinder(series, summary, R):
     return out
 
 
+LAME_FREE_NODES = 32  # the free Lame scenes' bore probes n00..n31, s00..s31
+
+
+def _wrap(angle):
+    return (angle + math.pi) % (2.0 * math.pi) - math.pi
+
+
+def _particle_angle(ux, uy, theta):
+    """A bore particle's polar angle, from its displacement: radial in the exact solution
+    (nothing rotates a free body's solution: the solver reports it with zero mean rotation),
+    so this is the particle's own angle up to the solution's tangential error, which moves
+    u_r and sigma_tt at second order only. The particles sit up to half their spacing off the
+    probe points (3.5 degrees at 8 through), which the probe's angle theta would read as a
+    first-order error (sigma_tt rotated towards sigma_rr: up to -0.6 %). theta itself where
+    the displacement points more than a probe spacing away from it (a wrong solution, which
+    must show)."""
+    phi = math.atan2(uy, ux)
+    return phi if abs(_wrap(phi - theta)) <= 2.0 * math.pi / LAME_FREE_NODES else theta
+
+
+def extract_lame_free(key):
+    """The textbook Lame ring or cylinder (outer surface free, a free body): at each of the 32
+    bore probes j (theta_j = 2 pi j / 32; in 3D at mid-length) the radial displacement of the
+    nearest particle (nXX) and the hoop stress recovered at the nearest bore particle (sXX),
+    both at the particle's own polar angle (_particle_angle): u_r = cos u_x + sin u_y,
+    sigma_tt = sin^2 sxx + cos^2 syy - 2 sin cos sxy. Reported: their means (u_a, stt_s) and
+    the largest |error| over the 32 nodes (u_a_worst, stt_s_worst: the headline, node by
+    node); in 3D also u_x of the particle at (a, 0, 0) on the free end (u_end)."""
+    def extract(series, summary, R):
+        ref = R[key]
+        n = LAME_FREE_NODES
+        ur, stt, srr, offsets = [], [], [], []
+        for j in range(n):
+            theta = 2.0 * math.pi * j / n
+            ux, uy = series["n%02d_ux" % j][-1], series["n%02d_uy" % j][-1]
+            phi = _particle_angle(ux, uy, theta)
+            ur.append(math.cos(phi) * ux + math.sin(phi) * uy)
+            sp = "s%02d_" % j
+            phi = _particle_angle(series[sp + "ux"][-1], series[sp + "uy"][-1], theta)
+            offsets.append(abs(math.degrees(_wrap(phi - theta))))
+            c, s = math.cos(phi), math.sin(phi)
+            sxx, syy, sxy = series[sp + "sxx"][-1], series[sp + "syy"][-1], series[sp + "sxy"][-1]
+            stt.append(s * s * sxx + c * c * syy - 2.0 * s * c * sxy)
+            srr.append(c * c * sxx + s * s * syy + 2.0 * s * c * sxy)
+        eu = [pct(u, ref["u_a"]) for u in ur]
+        es = [pct(x, ref["stt_a"]) for x in stt]
+        ju = max(range(n), key=lambda i: abs(eu[i]))
+        js = max(range(n), key=lambda i: abs(es[i]))
+        v = {"u_a": sum(ur) / n, "u_a_min": min(ur), "u_a_max": max(ur),
+             "stt_s": sum(stt) / n, "stt_s_min": min(stt), "stt_s_max": max(stt),
+             "srr_s": sum(srr) / n, "u_a_worst_node": ju, "stt_s_worst_node": js,
+             "angle_offset_max_deg": max(offsets)}
+        e = {"u_a": pct(v["u_a"], ref["u_a"]), "u_a_worst": abs(eu[ju]),
+             "stt_s": pct(v["stt_s"], ref["stt_a"]), "stt_s_worst": abs(es[js]),
+             "srr_s": pct(v["srr_s"], ref["srr_a"])}
+        if "end_x_ux" in series:  # the 3D cylinder's free end, (a, 0, 0)
+            v["u_end"] = series["end_x_ux"][-1]
+            e["u_end"] = pct(v["u_end"], ref["u_end"])
+        return {"values": v, "errors": e, "primary": "stt_s_worst"}
+    extract.__name__ = "extract_" + key
+    return extract
+
+
 def extract_bracket(series, summary, R):
     ref = R["bracket"]
     ux, uz = series["P_ux"][-1], series["P_uz"][-1]
@@ -634,12 +713,15 @@ class Problem:
                  static, qoi, unit, target=None, variants=None, sensitivity=None,
                  checked=None, cross=None, quick_variant=0, sens_variant=0,
                  variant_ladders=None, clamps=None, newton_memory=None, quick_twin=False,
-                 agree=None, twin_skip=None):
+                 agree=None, twin_skip=None, no_twin=None, target_at=None):
         self.key, self.title, self.scene, self.dim = key, title, scene, dim
         self.thickness, self.ladder = thickness, ladder
         self.quick_dx, self.sens_dx = quick_dx, sens_dx
         self.extract, self.static, self.qoi, self.unit = extract, static, qoi, unit
         self.target = target  # (error name, |error| % at the finest resolution)
+        # where the target is evaluated when not at each variant's finest resolution:
+        # {"per_thickness": n, "variant": name, "errors": [more error names held to it]}
+        self.target_at = target_at
         self.variants = variants or [("", {})]
         self.sensitivity = sensitivity or {}
         self.checked = checked or []  # error names the quick check compares
@@ -656,6 +738,9 @@ class Problem:
         self.agree = agree or []
         # ladder resolutions whose twin is not run, with the reason (recorded as skipped)
         self.twin_skip = twin_skip or {}
+        # a static problem with no twins at all, and why (a body nothing holds: the damped
+        # solver refuses it): its ladder runs are Newton only, and no twin records
+        self.no_twin = no_twin
 
 
 # The 3D problems' sensitivity studies run at the coarsest ladder resolution (4 per thickness),
@@ -729,6 +814,17 @@ NEWTON_MEMORY = {  # measured peak resident memory of the Newton runs (multigrid
 # below the tolerance, and the displacement error that leaves is of the same order (measured:
 # 1e-7 to 4e-5 relative at tolerance 1e-5).
 NEWTON_AGREEMENT = 10.0
+
+# The free Lame problems (bodies nothing holds): the damped solver refuses them, Newton only.
+FREE_BODY_NO_TWIN = ("a body nothing holds: the damped solver is refused (\"solver = newton "
+                     "solves a body nothing holds\"), Newton only")
+# Their Newton memory models (n_ref, GB at n_ref, exponent; NEWTON_MEMORY), anchored at the
+# largest peak measured at the finest resolution (2 threads, 2026-12-07): the ring 0.22, 0.25,
+# 0.25 GB at 32 through (defaults, ic-s2.5, lin-s2.5); the cylinder at 16 through 1.66 GB with
+# lin-s2.5 (multigrid) and 5.08 GB at the defaults, where the multigrid stalled on the free
+# body and Newton fell back to a Cholesky factor (4.4e8 entries, 475 s); 0.25 and 0.34 GB at
+# 8. Exponents: the 2D bound of the other 2D problems, the clamped cylinder's 3.0.
+LAME_FREE_MEMORY = {"lame_ring_free": (32, 0.25, 2.5), "lame_cylinder_free": (16, 5.08, 3.0)}
 
 # The mesh bodies with a pressure-loaded curved surface, also with the gradient correction that
 # makes a uniform stress balance its tractions (docs/method.md section 3.4).
@@ -839,6 +935,37 @@ PROBLEMS = [
             newton_memory=(16, 1.09, 3.0), agree=["u_a", "stt_a"],
             variants=LAME_VARIANTS + [("lin-s2.5", {"kernel.integration_constraint": "linear",
                                                     "kernel.support": "2.5"})]),
+    # The textbook Lame problem: the same ring and cylinder with the outer surface free and
+    # nothing holding them (free bodies: the Newton solver leaves the rigid motions out and
+    # reports the displacement with zero mean translation and rotation). The damped solver
+    # refuses such a body, so these have no damped twins. Headline: the worst of the 32 bore
+    # nodes' recovered hoop stress; the target (the issue's): u(a) and that worst within 1 % at
+    # 16 through the wall with the linear-stress constraint at support 2.5 (lin-s2.5).
+    Problem("lame_ring_free", "Free thick-walled cylinder (textbook Lame): internal pressure, "
+            "outer surface free, nothing holding it, gmsh body, plane strain, static, 2D",
+            "lame_ring_free.ini", 2, 0.05, [0.05 / 8, 0.05 / 16, 0.05 / 32], 0.05 / 8,
+            0.05 / 8, extract_lame_free("lame_ring_free"), True,
+            "worst bore hoop stress (32 nodes)", "Pa",
+            target=("stt_s_worst", 1.0),
+            target_at={"per_thickness": 16, "variant": "lin-s2.5", "errors": ["u_a"]},
+            checked=["u_a", "u_a_worst", "stt_s", "stt_s_worst"],
+            newton_memory=LAME_FREE_MEMORY["lame_ring_free"], no_twin=FREE_BODY_NO_TWIN,
+            variants=[("", {}), ("ic-s2.5", {"kernel.integration_constraint": "true",
+                                              "kernel.support": "2.5"}),
+                      ("lin-s2.5", {"kernel.integration_constraint": "linear",
+                                    "kernel.support": "2.5"})],
+            quick_variant=2),
+    Problem("lame_cylinder_free", "Free thick-walled cylinder in 3D (textbook Lame): internal "
+            "pressure, outer surface and ends free, nothing holding it, gmsh body, static",
+            "lame_cylinder_free.ini", 3, 0.05, [0.05 / 8, 0.05 / 16], 0.05 / 8, 0.05 / 8,
+            extract_lame_free("lame_cylinder_free"), True,
+            "worst bore hoop stress (32 nodes, L/2)", "Pa",
+            target=("stt_s_worst", 1.0),
+            target_at={"per_thickness": 16, "variant": "lin-s2.5", "errors": ["u_a"]},
+            checked=["u_a", "u_a_worst", "stt_s", "stt_s_worst", "u_end"],
+            newton_memory=LAME_FREE_MEMORY["lame_cylinder_free"], no_twin=FREE_BODY_NO_TWIN,
+            variants=[("", {}), ("lin-s2.5", {"kernel.integration_constraint": "linear",
+                                              "kernel.support": "2.5"})]),
     Problem("plate_hole_fitted", "Plate with a central hole in tension, gmsh body fitted to "
             "the hole, plane strain, static, 2D", "plate_hole_fitted.ini", 2, 0.02,
             [0.0025, 0.00125, 0.000625], 0.0025, 0.0025, extract_plate_hole_fitted, True,
@@ -937,7 +1064,7 @@ def plan_runs(quick, sensitivity, only, twins=True):
         solver = primary_solver(p)
         runs.append(dict(problem=p.key, variant=name, dx=dx, kind="ladder", param=None,
                          value=None, overrides=dict(ov), solver=solver, twin=None))
-        if p.static and twins and with_twin:
+        if p.static and twins and with_twin and not p.no_twin:
             o = dict(ov)
             o["static.solver"] = other_solver(solver)
             runs.append(dict(problem=p.key, variant=name, dx=dx, kind="ladder", param=None,
@@ -1418,6 +1545,7 @@ def problems_table():
                     "thickness": p.thickness, "ladder": p.ladder, "quick_dx": p.quick_dx,
                     "sensitivity_dx": p.sens_dx, "qoi": p.qoi, "unit": p.unit,
                     "static": p.static, "target": p.target,
+                    **({"target_at": p.target_at} if p.target_at else {}),
                     "variants": [v for v, _ in p.variants], "checked": p.checked,
                     "variant_overrides": {v: o for v, o in p.variants},
                     "quick_variant": p.variants[p.quick_variant][0],
@@ -1429,7 +1557,9 @@ def problems_table():
                                                          p.newton_memory))
                                 if p.newton_memory else None,
                                 "agree": p.agree, "quick": p.quick_twin,
-                                "twin_solver": other_solver(primary_solver(p)),
+                                "twin_solver": (None if p.no_twin else
+                                                other_solver(primary_solver(p))),
+                                **({"no_twin": p.no_twin} if p.no_twin else {}),
                                 "sensitivity_solver": SENSITIVITY_SOLVER,
                                 "agreement_factor": NEWTON_AGREEMENT}
                                if p.static else None)}
