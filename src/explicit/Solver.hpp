@@ -256,13 +256,13 @@ class Solver {
 
   // Out-of-balance force of a quasi-static run: |sum over free particles of (f_int + f_ext)|_2
   // relative to the size of the forces that hold the body (external loads and reactions).
-  // A free body's (leaveOutRigidPart): of the residual's deformation part.
+  // For a free body (leaveOutRigidPart) the sum is of the forces' deformation part.
   double residualRatio() const {
     requireSynchronized();
     const auto& p = scene_.particles;
     double residual = 0.0, reference = 0.0;
     for (Index i : free_) {
-      residual += totalForce(i).squaredNorm();
+      if (!rigidLeftOut_) residual += totalForce(i).squaredNorm();
       if (loads_.any()) reference += loads_.force()[i].squaredNorm();
     }
     if (rigidLeftOut_) {
