@@ -21,6 +21,7 @@
 #include "explicit/Solver.hpp"
 #include "geometry/Lattice.hpp"
 #include "geometry/LocalityOrder.hpp"
+#include "scene/ParticleSetChecks.hpp"
 #ifdef TLSPH_HAVE_MPI
 #include <mpi.h>
 
@@ -80,9 +81,10 @@ int main(int argc, char** argv) {
   po::options_description options("tlsph_bench: 3D cantilever throughput");
   options.add_options()("help", "this help")("dx", po::value(&dx)->default_value(dx),
                                              "particle spacing [m] (0.0125: 80 x 8 x 8)")(
-      "support", po::value(&supportRatio)->default_value(supportRatio),
-      "kernel support H/dx (2.1: 32 neighbours)")("alpha", po::value(&alpha)->default_value(alpha),
-                                                  "hourglass coefficient")(
+      "support", po::value(&supportRatio),
+      "kernel support H/dx; default 2.1 on the lattice (32 neighbours), 2.5 with --jitter above "
+      "1e-4, as a scene's particle file off a lattice gets")(
+      "alpha", po::value(&alpha)->default_value(alpha), "hourglass coefficient")(
       "material", po::value(&material)->default_value(material), "material model")(
       "steps", po::value(&steps)->default_value(steps), "time steps to time")(
       "particles", po::value(&particles),
@@ -113,6 +115,8 @@ int main(int argc, char** argv) {
 
   if (particles > 0) dx = 0.1 / std::max(1L, std::lround(std::cbrt(particles / (10.0 * length))));
   stream = !vm.count("no-stream");
+  if (!vm.count("support"))
+    supportRatio = jitter > kLatticeTolerance ? kOffLatticeSupportRatio : 2.1;
   if (!(jitter >= 0.0 && jitter < 0.25)) {
     std::cerr << "tlsph_bench: --jitter " << jitter
               << ": expected a fraction of dx in [0, 0.25) (larger moves a particle across the "

@@ -118,6 +118,9 @@ class Builder {
   // A body read from a particle file or meshed from a CAD or mesh file, the scene's only body
   // (FreeFormBodies.cpp); the named surfaces conditions refer to.
   bool freeFormBodyGiven() const;
+  void chooseSupport(const std::vector<Vec<D>>& X, const std::vector<double>& V);
+  void refuseOverlap(SectionReader& r, const std::vector<Vec<D>>& X, const std::vector<double>& V,
+                     const std::string& what);
   void fillFreeFormBody();
   void checkIntegrationConstraint();
   const SurfacePatch<D>& namedSurface(SectionReader& r, const std::string& key = "surface");
@@ -127,6 +130,7 @@ class Builder {
   std::string readMotion(SectionReader& r, Prescription<D>& rule);
   static std::string motionText(const Prescription<D>& rule);
   void addNodalClamp(SectionReader& r, const std::string& name, std::set<std::string>& facesUsed);
+  void addMirroredFileClamp(SectionReader& r, const std::string& name, const std::string& face);
   void readPrescriptions();
 
   // [gravity], [load.NAME], [initial.NAME] (LoadSections.cpp).
@@ -146,6 +150,7 @@ class Builder {
   Eigen::AlignedBox<double, D> bodyBox_;
   std::size_t maxParticles_ = 0;
   double supportRatio_ = 2.0;
+  bool particleFile_ = false;           // the body is read from a particle file
   bool integrationConstraint_ = false;  // [kernel] integration_constraint
   bool integrationLinear_ = false;      // ... = linear
   Index bodyCount_ = 0;

@@ -1,6 +1,8 @@
 // [clamp.NAME] and [prescribe.NAME]: the particles whose motion is given, and the clamps'
 // ghost layers.
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <set>
 #include <string>
 #include <vector>
@@ -148,13 +150,27 @@ template <int D>
 void Builder<D>::addNodalClamp(SectionReader& r, const std::string& name,
                                std::set<std::string>& facesUsed) {
   auto& p = setup_.scene.particles;
-  const std::string method =
-      r.word("method", "nodal", {"nodal", "mirror", "mirror-quadratic", "fixed"});
+  // A particle file's face is mirrored by default, as a lattice body's; a mesh's particles lie
+  // on its surface, which is where a nodal clamp holds them.
+  const bool mirrorable = particleFile_ && !r.has("surface");
+  const std::string method = r.word("method", mirrorable ? "mirror" : "nodal",
+                                    {"nodal", "mirror", "mirror-quadratic", "fixed"});
+  if (method == "mirror" && mirrorable) {
+    const std::string face = r.word("face", std::nullopt, faceNames());
+    if (!facesUsed.insert(face).second) throw r.error("face", "face " + face + " is clamped twice");
+    addMirroredFileClamp(r, name, face);
+    return;
+  }
   if (method != "nodal")
     throw r.error("method",
-                  "a body read from a file (shape = particles or mesh) is clamped at "
-                  "its particles on the surface (method = nodal): '" +
-                      method + "' needs the lattice's layers behind a face");
+                  mirrorable
+                      ? "a face of a particle file is clamped by mirroring (method = mirror, "
+                        "the default) or by holding its particles (nodal); '" +
+                            method + "' needs the lattice's layers behind a face"
+                      : "a body meshed from a file is clamped at its particles on the surface "
+                        "(method = nodal): '" +
+                            method + "' needs particles behind a plane face to mirror");
+  if (r.has("at")) throw r.error("at", "applies only with method = mirror on a particle file");
   std::vector<Index> held;
   std::string where;
   if (r.has("surface")) {
@@ -189,6 +205,76 @@ void Builder<D>::addNodalClamp(SectionReader& r, const std::string& name,
   setup_.conditions.push_back("clamp." + name + ": " + where + ", nodal, " +
                               (motion == "fixed" ? "" : motion + " " + motionText(clamp) + ", ") +
                               std::to_string(held.size()) + " particles held");
+  setup_.scene.prescriptions.push_back(std::move(clamp));
+}
+
+// A clamp at a face of a body read from a particle file, mirrored as a lattice body's is: the
+// face is a plane (given, or where the particles' cells end), and every particle within the
+// ghost layers' depth of it gets a ghost at its reflection that takes the odd reflection of its
+// displacement (MirrorGhost), so u = 0 sits on the plane, not half a spacing inside the body.
+template <int D>
+void Builder<D>::addMirroredFileClamp(SectionReader& r, const std::string& name,
+                                      const std::string& face) {
+  auto& p = setup_.scene.particles;
+  const auto& X = p.referencePosition;
+  const int axis = face[0] - 'x';
+  const double sign = face[1] == '-' ? -1.0 : 1.0;  // the outward normal along the axis
+  auto spacing = [&](Index i) { return std::pow(p.volume[i], 1.0 / D); };
+  // Where the particles' cells end: the plane a lattice body's face would be.
+  double cellEdge = -sign * std::numeric_limits<double>::infinity();
+  for (Index i = 0; i < bodyCount_; ++i) {
+    const double edge = X[i][axis] + sign * 0.5 * spacing(i);
+    cellEdge = sign > 0 ? std::max(cellEdge, edge) : std::min(cellEdge, edge);
+  }
+  const double plane = r.has("at") ? r.number("at") : cellEdge;
+  const int layersNeeded = static_cast<int>(std::ceil(supportRatio_ - 1e-9));
+  const long layers = r.integer("layers", layersNeeded);
+  if (layers < layersNeeded)
+    throw r.error("layers",
+                  std::to_string(layers) + " ghost layers do not fill the kernel support (H/dx = " +
+                      fmt(supportRatio_) + " needs " + std::to_string(layersNeeded) + ")");
+  Prescription<D> clamp;
+  clamp.name = "clamp." + name;
+  const std::string motion = readMotion(r, clamp);
+  // Every particle must lie on the body's side of the plane.
+  for (Index i = 0; i < bodyCount_; ++i)
+    if (sign * (X[i][axis] - plane) >= 0.0)
+      throw r.error("at", "particle " + std::to_string(i) + " at " + fmt<D>(X[i]) +
+                              " lies on or beyond the clamp's plane " + face.substr(0, 1) + " = " +
+                              fmt(plane) + " (face " + face + ")");
+  r.finish();
+  const std::string holds = "mirrors the particles within " + std::to_string(layers) +
+                            " spacings of the plane " + face.substr(0, 1) + " = " + fmt(plane);
+  const int rule = static_cast<int>(setup_.scene.prescriptions.size());
+  Index ghosts = 0;
+  for (Index i = 0; i < bodyCount_; ++i) {
+    const double depth = sign * (plane - X[i][axis]);
+    if (depth >= double(layers) * spacing(i)) continue;
+    if (const auto c = clampHeld_.find(i); c != clampHeld_.end())
+      throw r.error("face", "particle " + std::to_string(i) + " at " + fmt<D>(X[i]) +
+                                " is mirrored by [clamp." + c->second.first +
+                                "] too: two clamped faces closer than the ghost layers' depth");
+    clampHeld_.emplace(i, std::pair{name, holds});
+    Vec<D> G = X[i];
+    G[axis] = 2.0 * plane - X[i][axis];
+    MirrorGhost m;
+    m.mirror = i;
+    m.motion = rule;
+    const std::uint16_t mat = p.material[i];
+    m.ghost = p.add(G, p.volume[i], p.mass[i], mat, Motion::Mirrored);
+    setup_.scene.mirrorGhosts.push_back(m);
+    setup_.body.push_back(setup_.body[i]);
+    setup_.ghost.push_back(1);
+    ++ghosts;
+  }
+  if (static_cast<double>(p.size()) > double(maxParticles_))
+    throw r.error("layers", "the ghosts make " + std::to_string(p.size()) +
+                                " particles, more than [scene] max_particles = " +
+                                std::to_string(maxParticles_));
+  setup_.conditions.push_back(
+      "clamp." + name + ": face " + face + " at " + face.substr(0, 1) + " = " + fmt(plane) +
+      ", mirror, " + (motion == "fixed" ? "" : motion + " " + motionText(clamp) + ", ") +
+      std::to_string(layers) + " ghost layers, " + std::to_string(ghosts) + " ghost particles");
   setup_.scene.prescriptions.push_back(std::move(clamp));
 }
 
@@ -263,5 +349,10 @@ template void Builder<3>::addClamps();
 template std::string Builder<3>::readMotion(SectionReader&, Prescription<3>&);
 template std::string Builder<3>::motionText(const Prescription<3>&);
 template void Builder<3>::readPrescriptions();
+
+template void Builder<2>::addMirroredFileClamp(SectionReader&, const std::string&,
+                                               const std::string&);
+template void Builder<3>::addMirroredFileClamp(SectionReader&, const std::string&,
+                                               const std::string&);
 
 }  // namespace tlsph::scene_build

@@ -14,6 +14,7 @@
 #include "geometry/LocalityOrder.hpp"
 #include "io/ParticleFile.hpp"
 #include "scene/Builder.hpp"
+#include "scene/ParticleSetChecks.hpp"
 
 namespace tlsph::scene_build {
 
@@ -99,6 +100,7 @@ void Builder<D>::fillFreeFormBody() {
     }
     what = "particles from " + file.string();
     setup_.coarsenable = false;
+    particleFile_ = true;
   } else {
     const double size = r.has("size") ? r.positive("size") : setup_.dx;
     setup_.coarsenable = !r.has("size");
@@ -130,6 +132,8 @@ void Builder<D>::fillFreeFormBody() {
     throw r.error("file", std::to_string(X.size()) +
                               " particles, more than [scene] max_particles = " +
                               std::to_string(maxParticles_));
+  if (kind == "particles") chooseSupport(X, V);
+  refuseOverlap(r, X, V, kind == "particles" ? "the file's particles" : "the mesh's volumes");
 
   // Numbered with the longest axis slowest, as lattice bodies are (LocalityOrder.hpp); the
   // surfaces' and volumes' particle lists follow the new numbers.
@@ -224,6 +228,51 @@ void Builder<D>::fillFreeFormBody() {
                               "the particles' spacing");
 }
 
+// A particle file off a lattice needs a wider support for the quadratic fit across its faces
+// (ParticleSetChecks.hpp), unless [kernel] support says otherwise.
+template <int D>
+void Builder<D>::chooseSupport(const std::vector<Vec<D>>& X, const std::vector<double>& V) {
+  if (config_.find("kernel", "support") || onCellCentredLattice<D>(X, V)) return;
+  supportRatio_ = kOffLatticeSupportRatio;
+  setup_.scene.supportRadius = supportRatio_ * setup_.dx;
+  setup_.conditions.push_back("kernel: support " + fmt(supportRatio_) +
+                              " dx (the particles are not on a lattice: the quadratic fit "
+                              "needs a second layer of neighbours across each face)");
+}
+
+// Particles whose volumes count twice somewhere (two overlapping volumes of a CAD model, two
+// clouds in one file) are refused, the densest one named; so are two particles on top of each
+// other.
+template <int D>
+void Builder<D>::refuseOverlap(SectionReader& r, const std::vector<Vec<D>>& X,
+                               const std::vector<double>& V, const std::string& what) {
+  const DensityPeak peak =
+      densityPeak<D>(X, V, Kernel<D>(setup_.scene.kernel, setup_.scene.supportRadius));
+  if (peak.density > kOverlapDensity)
+    throw r.error("file",
+                  what + " overlap: near particle (numbered from 0 as read) " +
+                      std::to_string(peak.particle) + " at " + fmt<D>(X[peak.particle]) +
+                      " the kernel-weighted sum of the volumes is " + fmt(peak.density) +
+                      " (about 1 where the particles tile the body, 2 where " +
+                      "two parts cover the same space); its nearest particle, " +
+                      std::to_string(peak.closest) + " at " + fmt<D>(X[peak.closest]) + ", is " +
+                      fmt(peak.distance) +
+                      " away. Fuse overlapping volumes in the CAD model (a boolean union), remove "
+                      "the doubled particles from the file, or set [scene] dx near the particles' "
+                      "spacing");
+  const ClosestPair pair = closestPair<D>(X, V, setup_.scene.supportRadius);
+  if (pair.ratio < kCloseRatio)
+    throw r.error("file",
+                  "particles (numbered from 0 as read) " + std::to_string(pair.first) + " at " +
+                      fmt<D>(X[pair.first]) + " and " + std::to_string(pair.second) + " at " +
+                      fmt<D>(X[pair.second]) + " are " +
+                      fmt(pair.ratio * std::pow(std::min(V[pair.first], V[pair.second]), 1.0 / D)) +
+                      " apart, " + fmt(pair.ratio) + " of their spacing V^(1/d) (at least " +
+                      fmt(kCloseRatio) +
+                      " expected): the kernel cannot tell them apart; remove one or "
+                      "merge their volumes");
+}
+
 template <int D>
 const SurfacePatch<D>& Builder<D>::namedSurface(SectionReader& r, const std::string& key) {
   std::vector<std::string> known;
@@ -253,6 +302,12 @@ template bool Builder<2>::freeFormBodyGiven() const;
 template void Builder<2>::fillFreeFormBody();
 template void Builder<2>::checkIntegrationConstraint();
 template const SurfacePatch<2>& Builder<2>::namedSurface(SectionReader&, const std::string&);
+template void Builder<2>::chooseSupport(const std::vector<Vec<2>>&, const std::vector<double>&);
+template void Builder<2>::refuseOverlap(SectionReader&, const std::vector<Vec<2>>&,
+                                        const std::vector<double>&, const std::string&);
+template void Builder<3>::chooseSupport(const std::vector<Vec<3>>&, const std::vector<double>&);
+template void Builder<3>::refuseOverlap(SectionReader&, const std::vector<Vec<3>>&,
+                                        const std::vector<double>&, const std::string&);
 template bool Builder<3>::freeFormBodyGiven() const;
 template void Builder<3>::fillFreeFormBody();
 template void Builder<3>::checkIntegrationConstraint();

@@ -21,6 +21,7 @@
 #include "explicit/Solver.hpp"
 #include "scene/Config.hpp"
 #include "scene/InputError.hpp"
+#include "scene/ParticleSetChecks.hpp"
 #include "scene/SceneBuilder.hpp"
 
 using namespace tlsph;
@@ -203,10 +204,23 @@ TEST(ParticleFile, ErrorsNameTheFileTheLineAndTheProblem) {
   EXPECT_NE(message("x,y,volume\n0,0,1e-4\n", "[hole.h]\nshape = ball\ncentre = 0 0\nradius = 1\n")
                 .find("cut the hole in the CAD model"),
             std::string::npos);
-  // Mirrored clamps need the lattice.
-  EXPECT_NE(message("x,y,volume\n0,0,1e-4\n1,0,1e-4\n", "[clamp.c]\nface = x-\nmethod = mirror\n")
-                .find("method = nodal"),
+  // A particle file's face is mirrored (odd reflection) or held; the quadratic extrapolation
+  // needs the lattice's layers.
+  EXPECT_NE(message("x,y,volume\n0,0,1e-4\n1,0,1e-4\n",
+                    "[clamp.c]\nface = x-\nmethod = mirror-quadratic\n")
+                .find("method = mirror"),
             std::string::npos);
+  // The mirror's plane must leave every particle on the body's side.
+  EXPECT_NE(
+      message("x,y,volume\n0,0,1e-4\n1,0,1e-4\n", "[clamp.c]\nface = x-\nat = 0.5\n")
+          .find("[clamp.c] at: particle 0 at (0 0) lies on or beyond the clamp's plane x = 0.5"),
+      std::string::npos);
+  // Particles on top of each other, and two clouds over the same space, are refused by name.
+  EXPECT_NE(
+      message("x,y,volume\n0,0,1e-4\n0.01,0,1e-4\n0.0101,0,1e-4\n")
+          .find("particles (numbered from 0 as read) 1 at (0.01    0) and 2 at (0.0101      0)"),
+      std::string::npos)
+      << message("x,y,volume\n0,0,1e-4\n0.01,0,1e-4\n0.0101,0,1e-4\n");
 }
 
 TEST(ParticleFile, AClampOnAFaceHoldsTheParticlesThere) {
@@ -214,7 +228,7 @@ TEST(ParticleFile, AClampOnAFaceHoldsTheParticlesThere) {
   std::ofstream(dir.path / "set.csv") << "x,y,volume\n0,0,1\n0,1,1\n1,0,1\n1,1,1\n2,0.5,1\n";
   const auto setup = build<2>(sceneHead(2, 1.0) +
                                   "[body.b]\nshape = particles\nfile = set.csv\n[clamp.c]\nface "
-                                  "= x-\n",
+                                  "= x-\nmethod = nodal\n",
                               dir.path / "s.ini");
   ASSERT_EQ(setup.scene.prescriptions.size(), 1u);
   const auto& held = setup.scene.prescriptions[0].particles;
@@ -224,6 +238,132 @@ TEST(ParticleFile, AClampOnAFaceHoldsTheParticlesThere) {
     EXPECT_EQ(setup.scene.particles.motion[i], Motion::Prescribed);
   }
   EXPECT_FALSE(setup.coarsen);  // a particle file cannot be rebuilt at a coarser dx
+}
+
+namespace {
+
+// A lattice box's particles read from a file and clamped at a face (mirrored by default) give
+// the lattice body's run: the ghosts are the same reflections, found from the plane where the
+// particles' cells end rather than from the lattice (equal up to the rounding of that plane).
+template <int D>
+void expectMirroredClampAsTheLattice() {
+  ScratchFolder dir;
+  const std::string box = D == 2 ? "[body.block]\nshape = box\nlower = 0 0\nupper = 0.1 0.04\n"
+                                 : "[body.block]\nshape = box\nlower = 0 0 0\nupper = 0.1 0.04 "
+                                   "0.03\n";
+  const std::string clamp = "[clamp.root]\nface = x-\n" + drive<D>();
+  const double dx = 0.01;
+  SceneSetup<D> lattice = build<D>(sceneHead(D, dx) + box + clamp, dir.path / "box.ini");
+  std::vector<Vec<D>> X;
+  std::vector<double> V;
+  ParticleSet<D> body;
+  for (Index i = 0; i < lattice.scene.particles.size(); ++i)
+    if (!lattice.ghost[i])
+      body.add(lattice.scene.particles.referencePosition[i], lattice.scene.particles.volume[i],
+               lattice.scene.particles.mass[i], 0);
+  writeCsv<D>(dir.path / "block.csv", body);
+  SceneSetup<D> read =
+      build<D>(sceneHead(D, dx) + "[body.block]\nshape = particles\nfile = block.csv\n" + clamp,
+               dir.path / "read.ini");
+  // The lattice adds ceil(H/dx) = 3 ghost layers; the file's clamp those within 3 spacings.
+  ASSERT_EQ(read.scene.mirrorGhosts.size(), lattice.scene.mirrorGhosts.size());
+  Solver<D> a(lattice.scene, lattice.solver), b(read.scene, read.solver);
+  for (int k = 0; k < 40; ++k) {
+    a.step();
+    b.step();
+  }
+  double moved = 0.0, differs = 0.0;
+  const auto& pa = lattice.scene.particles;
+  const auto& pb = read.scene.particles;
+  for (Index i = 0; i < pb.size(); ++i) {
+    if (read.ghost[i]) continue;
+    // The same body particle in both (both numbered by locality, ghosts after the body).
+    ASSERT_EQ(pb.referencePosition[i], pa.referencePosition[i]);
+    moved = std::max(moved, pa.displacement[i].norm());
+    differs = std::max(differs, (pb.displacement[i] - pa.displacement[i]).norm());
+  }
+  EXPECT_GT(moved, 1e-4);
+  EXPECT_LT(differs, 1e-12 * moved);
+}
+
+}  // namespace
+
+TEST(ParticleFile, AMirroredClampRunsAsTheLatticeBodysClamp2D) {
+  expectMirroredClampAsTheLattice<2>();
+}
+TEST(ParticleFile, AMirroredClampRunsAsTheLatticeBodysClamp3D) {
+  expectMirroredClampAsTheLattice<3>();
+}
+
+// A particle set off the lattice takes support 2.5 unless the scene gives one; a lattice's
+// set keeps 2.1; two overlapping clouds are refused.
+TEST(ParticleFile, OffTheLatticeTheSupportWidensAndOverlapsAreRefused) {
+  ScratchFolder dir;
+  std::ofstream lattice(dir.path / "lattice.csv"), moved(dir.path / "moved.csv"),
+      doubled(dir.path / "doubled.csv");
+  for (auto* f : {&lattice, &moved, &doubled})
+    *f << "x,y,volume\n" << std::setprecision(17);
+  for (int i = 0; i < 10; ++i)
+    for (int j = 0; j < 6; ++j) {
+      const double x = (i + 0.5) * 0.01, y = (j + 0.5) * 0.01;
+      lattice << x << "," << y << ",1e-4\n";
+      doubled << x << "," << y << ",1e-4\n";
+      moved << x + 0.0005 * ((i * 7 + j * 3) % 5 - 2) / 2.0 << "," << y << ",1e-4\n";
+      if (i > 0 && j > 0) doubled << i * 0.01 << "," << j * 0.01 << ",1e-4\n";
+    }
+  lattice.close();
+  moved.close();
+  doubled.close();
+  auto support = [&](const std::string& file, const std::string& extra = "") {
+    return build<2>(
+               sceneHead(2, 0.01) + "[body.b]\nshape = particles\nfile = " + file + "\n" + extra,
+               dir.path / "s.ini")
+               .scene.supportRadius /
+           0.01;
+  };
+  EXPECT_NEAR(support("lattice.csv"), 2.1, 1e-12);
+  EXPECT_NEAR(support("moved.csv"), kOffLatticeSupportRatio, 1e-12);
+  EXPECT_NEAR(support("moved.csv", "[kernel]\nsupport = 2.2\n"), 2.2, 1e-12);
+  try {
+    support("doubled.csv");
+    ADD_FAILURE() << "two clouds over the same space were accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("the file's particles overlap"), std::string::npos)
+        << e.what();
+  }
+}
+
+// The volume density is about 1 inside a lattice and 2 where two lattices overlap; the lattice
+// test accepts rounding and refuses a shift of 1e-3 of the spacing.
+TEST(ParticleSetChecks, DensityAndLattice) {
+  std::vector<Vec<2>> X, Y;
+  std::vector<double> V, W;
+  for (int i = 0; i < 20; ++i)
+    for (int j = 0; j < 20; ++j) {
+      X.push_back(Vec<2>((i + 0.5) * 0.1, (j + 0.5) * 0.1));
+      V.push_back(0.01);
+    }
+  const Kernel<2> kernel(KernelType::WendlandC2, 0.21);
+  const auto rho = volumeDensity<2>(X, V, kernel);
+  EXPECT_NEAR(rho[10 * 20 + 10], 1.0, 0.05);  // inside
+  // Half a spacing inside a face the kernel reaches across it: 0.88.
+  EXPECT_GT(rho[0 * 20 + 10], 0.5);
+  EXPECT_LT(rho[0 * 20 + 10], 0.95);
+  Y = X;
+  W = V;
+  for (int i = 0; i < 20; ++i)
+    for (int j = 0; j < 20; ++j) {
+      Y.push_back(Vec<2>((i + 1.0) * 0.1, (j + 1.0) * 0.1));
+      W.push_back(0.01);
+    }
+  EXPECT_NEAR(densityPeak<2>(Y, W, kernel).density, 2.0, 0.1);
+  EXPECT_TRUE(onCellCentredLattice<2>(X, V));
+  auto shifted = X;
+  shifted[7].x() += 1e-9;
+  EXPECT_TRUE(onCellCentredLattice<2>(shifted, V));
+  shifted[7].x() += 1e-4;
+  EXPECT_FALSE(onCellCentredLattice<2>(shifted, V));
+  EXPECT_NEAR(closestPair<2>(X, V, 0.21).ratio, 1.0, 1e-12);
 }
 
 namespace {
