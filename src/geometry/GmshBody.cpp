@@ -544,6 +544,10 @@ MeshedBody<D> meshBody(const std::string& path, double size, const MeshOptions& 
       // A .geo script may have meshed already; the STL's triangles are its surfaces' geometry.
       if (kind != FileKind::Stl) gmsh::model::mesh::clear();
       setMeshOptions(D, size, options);
+      // An STL's geometry is its flat triangles: the order-2 nodes stay on the straight edges.
+      // Projected onto the triangles' reparametrised patches they kink across the triangles'
+      // edges and invert elements wherever the mesh is not much finer than the triangles.
+      if (kind == FileKind::Stl) gmsh::option::setNumber("Mesh.SecondOrderLinear", 1);
     });
     refuseCrashingAlgorithm(session);
     session.run(failure, [&] { gmsh::model::mesh::generate(D); });
