@@ -130,6 +130,7 @@ class Builder {
   std::string readMotion(SectionReader& r, Prescription<D>& rule);
   static std::string motionText(const Prescription<D>& rule);
   void addNodalClamp(SectionReader& r, const std::string& name, std::set<std::string>& facesUsed);
+  long ghostLayers(SectionReader& r);
   void addMirroredFileClamp(SectionReader& r, const std::string& name, const std::string& face);
   void readPrescriptions();
 

@@ -11,9 +11,20 @@
 
 namespace tlsph::scene_build {
 
+// A mirrored clamp's `layers`: at least ceil(H/dx), so that the kernel support is full.
+template <int D>
+long Builder<D>::ghostLayers(SectionReader& r) {
+  const int needed = static_cast<int>(std::ceil(supportRatio_ - 1e-9));
+  const long layers = r.integer("layers", needed);
+  if (layers < needed)
+    throw r.error("layers", std::to_string(layers) +
+                                " ghost layers do not fill the kernel support (H/dx = " +
+                                fmt(supportRatio_) + " needs " + std::to_string(needed) + ")");
+  return layers;
+}
+
 template <int D>
 void Builder<D>::addClamps() {
-  const int layersNeeded = static_cast<int>(std::ceil(supportRatio_ - 1e-9));
   auto& p = setup_.scene.particles;
   const auto& X = p.referencePosition;
   std::set<std::string> facesUsed;
@@ -31,13 +42,7 @@ void Builder<D>::addClamps() {
     const std::string face = r.word("face", std::nullopt, faceNames());
     if (!facesUsed.insert(face).second) throw r.error("face", "face " + face + " is clamped twice");
     const std::string method = r.word("method", "mirror", {"mirror", "mirror-quadratic", "fixed"});
-    const long layers = r.integer("layers", layersNeeded);
-    if (layers < layersNeeded)
-      throw r.error("layers", std::to_string(layers) +
-                                  " ghost layers do not fill the kernel support "
-                                  "(H/dx = " +
-                                  fmt(supportRatio_) + " needs " + std::to_string(layersNeeded) +
-                                  ")");
+    const long layers = ghostLayers(r);
     Prescription<D> clamp;
     clamp.name = "clamp." + name;
     const std::string motion = readMotion(r, clamp);
@@ -227,12 +232,7 @@ void Builder<D>::addMirroredFileClamp(SectionReader& r, const std::string& name,
     cellEdge = sign > 0 ? std::max(cellEdge, edge) : std::min(cellEdge, edge);
   }
   const double plane = r.has("at") ? r.number("at") : cellEdge;
-  const int layersNeeded = static_cast<int>(std::ceil(supportRatio_ - 1e-9));
-  const long layers = r.integer("layers", layersNeeded);
-  if (layers < layersNeeded)
-    throw r.error("layers",
-                  std::to_string(layers) + " ghost layers do not fill the kernel support (H/dx = " +
-                      fmt(supportRatio_) + " needs " + std::to_string(layersNeeded) + ")");
+  const long layers = ghostLayers(r);
   Prescription<D> clamp;
   clamp.name = "clamp." + name;
   const std::string motion = readMotion(r, clamp);
@@ -350,6 +350,8 @@ template std::string Builder<3>::readMotion(SectionReader&, Prescription<3>&);
 template std::string Builder<3>::motionText(const Prescription<3>&);
 template void Builder<3>::readPrescriptions();
 
+template long Builder<2>::ghostLayers(SectionReader&);
+template long Builder<3>::ghostLayers(SectionReader&);
 template void Builder<2>::addMirroredFileClamp(SectionReader&, const std::string&,
                                                const std::string&);
 template void Builder<3>::addMirroredFileClamp(SectionReader&, const std::string&,

@@ -246,8 +246,10 @@ void Builder<D>::chooseSupport(const std::vector<Vec<D>>& X, const std::vector<d
 template <int D>
 void Builder<D>::refuseOverlap(SectionReader& r, const std::vector<Vec<D>>& X,
                                const std::vector<double>& V, const std::string& what) {
-  const DensityPeak peak =
-      densityPeak<D>(X, V, Kernel<D>(setup_.scene.kernel, setup_.scene.supportRadius));
+  // One neighbour search for both checks (the set-up builds the body's own lists later).
+  const Kernel<D> kernel(setup_.scene.kernel, setup_.scene.supportRadius);
+  const NeighbourList nb = buildNeighbourList<D>(X, kernel.supportRadius());
+  const DensityPeak peak = densityPeak<D>(X, V, kernel, nb);
   if (peak.density > kOverlapDensity)
     throw r.error("file",
                   what + " overlap: near particle (numbered from 0 as read) " +
@@ -260,7 +262,7 @@ void Builder<D>::refuseOverlap(SectionReader& r, const std::vector<Vec<D>>& X,
                       " away. Fuse overlapping volumes in the CAD model (a boolean union), remove "
                       "the doubled particles from the file, or set [scene] dx near the particles' "
                       "spacing");
-  const ClosestPair pair = closestPair<D>(X, V, setup_.scene.supportRadius);
+  const ClosestPair pair = closestPair<D>(X, V, nb);
   if (pair.ratio < kCloseRatio)
     throw r.error("file",
                   "particles (numbered from 0 as read) " + std::to_string(pair.first) + " at " +

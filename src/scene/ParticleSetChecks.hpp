@@ -48,11 +48,10 @@ struct DensityPeak {
   double distance = 0.0;
 };
 
-// rho_I of every particle (the kernel's support as the scene sets it).
+// rho_I of every particle; nb: the lists within the kernel's support.
 template <int D>
 std::vector<double> volumeDensity(const std::vector<Vec<D>>& X, const std::vector<double>& V,
-                                  const Kernel<D>& kernel) {
-  const NeighbourList nb = buildNeighbourList<D>(X, kernel.supportRadius());
+                                  const Kernel<D>& kernel, const NeighbourList& nb) {
   std::vector<double> rho(X.size());
   for (Index i = 0; i < nb.particleCount(); ++i) {
     double sum = V[i] * kernel.value(0.0);
@@ -69,9 +68,10 @@ struct ClosestPair {
   double ratio = std::numeric_limits<double>::infinity();
 };
 
+// (Among the pairs of nb.)
 template <int D>
-ClosestPair closestPair(const std::vector<Vec<D>>& X, const std::vector<double>& V, double radius) {
-  const NeighbourList nb = buildNeighbourList<D>(X, radius);
+ClosestPair closestPair(const std::vector<Vec<D>>& X, const std::vector<double>& V,
+                        const NeighbourList& nb) {
   ClosestPair best;
   for (Index i = 0; i < nb.particleCount(); ++i)
     for (Index k = nb.offset[i]; k < nb.offset[i + 1]; ++k) {
@@ -86,10 +86,10 @@ ClosestPair closestPair(const std::vector<Vec<D>>& X, const std::vector<double>&
 // The particle with the largest rho_I and its nearest neighbour (for the message).
 template <int D>
 DensityPeak densityPeak(const std::vector<Vec<D>>& X, const std::vector<double>& V,
-                        const Kernel<D>& kernel) {
+                        const Kernel<D>& kernel, const NeighbourList& nb) {
   DensityPeak peak;
   if (X.empty()) return peak;
-  const std::vector<double> rho = volumeDensity<D>(X, V, kernel);
+  const std::vector<double> rho = volumeDensity<D>(X, V, kernel, nb);
   const auto top = std::max_element(rho.begin(), rho.end());
   peak.particle = static_cast<Index>(top - rho.begin());
   peak.density = *top;

@@ -344,7 +344,7 @@ TEST(ParticleSetChecks, DensityAndLattice) {
       V.push_back(0.01);
     }
   const Kernel<2> kernel(KernelType::WendlandC2, 0.21);
-  const auto rho = volumeDensity<2>(X, V, kernel);
+  const auto rho = volumeDensity<2>(X, V, kernel, buildNeighbourList<2>(X, 0.21));
   EXPECT_NEAR(rho[10 * 20 + 10], 1.0, 0.05);  // inside
   // Half a spacing inside a face the kernel reaches across it: 0.88.
   EXPECT_GT(rho[0 * 20 + 10], 0.5);
@@ -356,14 +356,14 @@ TEST(ParticleSetChecks, DensityAndLattice) {
       Y.push_back(Vec<2>((i + 1.0) * 0.1, (j + 1.0) * 0.1));
       W.push_back(0.01);
     }
-  EXPECT_NEAR(densityPeak<2>(Y, W, kernel).density, 2.0, 0.1);
+  EXPECT_NEAR(densityPeak<2>(Y, W, kernel, buildNeighbourList<2>(Y, 0.21)).density, 2.0, 0.1);
   EXPECT_TRUE(onCellCentredLattice<2>(X, V));
   auto shifted = X;
   shifted[7].x() += 1e-9;
   EXPECT_TRUE(onCellCentredLattice<2>(shifted, V));
   shifted[7].x() += 1e-4;
   EXPECT_FALSE(onCellCentredLattice<2>(shifted, V));
-  EXPECT_NEAR(closestPair<2>(X, V, 0.21).ratio, 1.0, 1e-12);
+  EXPECT_NEAR(closestPair<2>(X, V, buildNeighbourList<2>(X, 0.21)).ratio, 1.0, 1e-12);
 }
 
 namespace {
