@@ -75,6 +75,13 @@ def order(e1, e2, h1, h2):
     return math.log(abs(e1) / abs(e2)) / math.log(h1 / h2)
 
 
+def plateau(e1, e2, h1, h2):
+    """The error levels off: it keeps its sign and falls at an observed order below 1/2
+    between the two finest resolutions while above 0.05 %: refinement does not remove it."""
+    o = order(e1, e2, h1, h2)
+    return o is not None and o < 0.5 and abs(e2) > 0.05
+
+
 def order_text(e1, e2, h1, h2):
     if e1 is not None and e2 is not None and e1 != 0 and e2 != 0 and (e1 > 0) != (e2 > 0):
         return "sign change"
@@ -707,6 +714,9 @@ def readme(data, plots, plot_note):
         hs = [r["dx"] for r in lad]
         pe = [primary_error(r) for r in lad]
         o = order_text(pe[-2], pe[-1], hs[-2], hs[-1]) if len(lad) >= 2 else "-"
+        if len(lad) >= 2 and plateau(pe[-2], pe[-1], hs[-2], hs[-1]):
+            o += " (**plateau**)"
+            met = "**no** (a plateau)" if met.startswith("yes") else met
         q = fin.get("qoi") or {}
         title = p["title"] + ("" if not variant else ", " + variant_label(p, variant))
         extra = ", ".join("%s %s" % (label, f3(extra_error(fin, name), 2, signed=True))
@@ -725,7 +735,8 @@ def readme(data, plots, plot_note):
     L.append("")
     L.append("Details, what limits each target, and the sensitivity studies follow. "
              "Order = observed order of the error against the reference between the two finest "
-             "resolutions, `log(e1/e2)/log(dx1/dx2)`.")
+             "resolutions, `log(e1/e2)/log(dx1/dx2)`; a plateau (the error keeps its sign and "
+             "falls at an order below 1/2 while above 0.05 %) fails the target.")
     L.append("")
 
     # Hand-written findings for this run, if any (validation/report_notes.md).

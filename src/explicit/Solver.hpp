@@ -59,14 +59,16 @@ class Solver {
                 MirroredGhosts<D>::checkedGhostList(scene), scene.particles.quadratureMoments()) {
     if (!(settings.cfl > 0.0)) throw SetupError("the CFL number must be positive");
     const auto& p = scene.particles;
+    const std::vector<double> spacing = neighbourhoodSpacing<D>(ref_.neighbours, p.volume);
     if (plan_.active) {
       comm_ = comm;
       stable_ = globalStableStep(
           stableStep(p, scene.materials, settings.cfl, forces_.hourglassStiffness(),
-                     &plan_.partition.owned[comm->rank()]),
+                     &plan_.partition.owned[comm->rank()], spacing),
           *comm);
     } else {
-      stable_ = stableStep(p, scene.materials, settings.cfl, forces_.hourglassStiffness());
+      stable_ = stableStep(p, scene.materials, settings.cfl, forces_.hourglassStiffness(), nullptr,
+                           spacing);
     }
     dt_ = settings.timeStep > 0.0 ? settings.timeStep : stable_.dt;
     stepGiven_ = settings.timeStep > 0.0;

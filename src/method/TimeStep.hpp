@@ -1,13 +1,16 @@
 // The explicit stable time step (docs/method.md section 2):
 //   dt = C_cfl min_I dx_I / c_eff,I,   c_eff,I^2 = c_I^2 + c_hg,I^2,
-// dx_I = V_I^(1/d), c_I = sqrt((lambda + 2 mu)/rho0) of the particle's material, and
-// c_hg,I^2 = kappa dx_I^2 K_I / m_I the speed the hourglass penalty adds, K_I = sum_J k_IJ its
-// spring stiffness at I. kappa = 1/2 would be the Gershgorin bound of the spring network alone;
-// it overstates the fastest mode of penalty plus material several-fold, and kappa = 1/16 is
-// what the measured limits give (undamped 3D cantilever, 2D plate, quadratic correction, energy
-// penalty; limits in C of dx/c: alpha 0: 0.51 / 0.55, alpha 10: 0.49 / 0.55, alpha 100: 0.27 /
-// 0.35), so the rule's critical C stays near 0.5 for alpha from 0 to 100 (validation/stability
-// maps it). Only particles the integrator moves count.
+// dx_I = (mean of V_J over I and its neighbours)^(1/d), the spacing of I's neighbourhood: the
+// pair force on I scales with V_I like its mass, so I's acceleration is set by its neighbours'
+// spacing and the kernel, not by its own cell (a small cell among normal ones, as meshes give
+// at edges, does not make the operator faster); on a lattice it is V_I^(1/d). c_I = sqrt((lambda +
+// 2 mu)/rho0) of the particle's material, and c_hg,I^2 = kappa dx_I^2 K_I / m_I the speed the
+// hourglass penalty adds, K_I = sum_J k_IJ its spring stiffness at I. kappa = 1/2 would be the
+// Gershgorin bound of the spring network alone; it overstates the fastest mode of penalty plus
+// material several-fold, and kappa = 1/16 is what the measured limits give (undamped 3D cantilever,
+// 2D plate, quadratic correction, energy penalty; limits in C of dx/c: alpha 0: 0.51 / 0.55, alpha
+// 10: 0.49 / 0.55, alpha 100: 0.27 / 0.35), so the rule's critical C stays near 0.5 for alpha from
+// 0 to 100 (validation/stability maps it). Only particles the integrator moves count.
 #pragma once
 
 #include <cmath>
@@ -16,6 +19,7 @@
 #include <vector>
 
 #include "materials/Material.hpp"
+#include "method/NeighbourList.hpp"
 #include "model/Particles.hpp"
 
 namespace tlsph {
@@ -26,7 +30,7 @@ inline constexpr double kHourglassSpeedFactor = 1.0 / 16.0;  // kappa
 struct StableStep {
   double dt = 0.0;
   Index particle = -1;          // the particle that sets it
-  double dx = 0.0;              // its V^(1/d)
+  double dx = 0.0;              // its neighbourhood's spacing
   double waveSpeed = 0.0;       // its material's c
   double hourglassSpeed = 0.0;  // its c_hg
   // The penalty raises the effective wave speed at the limiting particle by this factor.
@@ -35,13 +39,30 @@ struct StableStep {
   }
 };
 
+// dx_I for each particle with a list in nb (the others: V_I^(1/d)). Written as V_I plus the mean
+// difference so that equal volumes give V_I^(1/d) to the bit.
+template <int D>
+std::vector<double> neighbourhoodSpacing(const NeighbourList& nb,
+                                         const std::vector<double>& volume) {
+  std::vector<double> dx(volume.size());
+  for (Index i = 0; i < static_cast<Index>(volume.size()); ++i) {
+    double difference = 0.0;
+    const Index n = i < nb.particleCount() ? nb.count(i) : 0;
+    for (Index k = 0; k < n; ++k)
+      difference += volume[nb.neighbour[nb.offset[i] + k]] - volume[i];
+    dx[i] = std::pow(volume[i] + difference / double(n + 1), 1.0 / D);
+  }
+  return dx;
+}
+
 // hourglassStiffness: K_I per particle, or empty when the penalty is off.
 // candidates: only these particles (ascending; a rank's own, whose stiffness it knows), else
-// all.
+// all. spacing: dx_I per particle (neighbourhoodSpacing), or empty for V_I^(1/d).
 template <int D>
 StableStep stableStep(const ParticleSet<D>& particles, const std::vector<Material>& materials,
                       double cfl, const std::vector<double>& hourglassStiffness = {},
-                      const std::vector<Index>* candidates = nullptr) {
+                      const std::vector<Index>* candidates = nullptr,
+                      const std::vector<double>& spacing = {}) {
   std::vector<double> speed(materials.size());
   for (std::size_t m = 0; m < materials.size(); ++m)
     speed[m] = waveSpeed(materials[m]);
@@ -54,7 +75,7 @@ StableStep stableStep(const ParticleSet<D>& particles, const std::vector<Materia
   for (Index q = 0; q < count; ++q) {
     const Index i = candidates ? (*candidates)[q] : q;
     if (anyFree && particles.motion[i] != Motion::Free) continue;
-    const double dx = std::pow(particles.volume[i], 1.0 / D);
+    const double dx = spacing.empty() ? std::pow(particles.volume[i], 1.0 / D) : spacing[i];
     const double c = speed[particles.material[i]];
     const double chg2 = hourglassStiffness.empty() ? 0.0
                                                    : kHourglassSpeedFactor * dx * dx *

@@ -118,6 +118,7 @@ class Builder {
   // A body read from a particle file or meshed from a CAD or mesh file, the scene's only body
   // (FreeFormBodies.cpp); the named surfaces conditions refer to.
   bool freeFormBodyGiven() const;
+  bool meshBodyGiven() const;  // a body with shape = mesh
   void chooseSupport(const std::vector<Vec<D>>& X, const std::vector<double>& V);
   void refuseOverlap(SectionReader& r, const std::vector<Vec<D>>& X, const std::vector<double>& V,
                      const std::string& what);

@@ -61,6 +61,15 @@ bool Builder<D>::freeFormBodyGiven() const {
 }
 
 template <int D>
+bool Builder<D>::meshBodyGiven() const {
+  for (const auto& name : config_.namesOf("body")) {
+    const ConfigEntry* e = config_.find("body." + name, "shape");
+    if (e && e->value == "mesh") return true;
+  }
+  return false;
+}
+
+template <int D>
 void Builder<D>::fillFreeFormBody() {
   const auto names = config_.namesOf("body");
   const auto given = std::find_if(names.begin(), names.end(),
@@ -301,6 +310,7 @@ void Builder<D>::checkIntegrationConstraint() {
 }
 
 template bool Builder<2>::freeFormBodyGiven() const;
+template bool Builder<2>::meshBodyGiven() const;
 template void Builder<2>::fillFreeFormBody();
 template void Builder<2>::checkIntegrationConstraint();
 template const SurfacePatch<2>& Builder<2>::namedSurface(SectionReader&, const std::string&);
@@ -311,6 +321,7 @@ template void Builder<3>::chooseSupport(const std::vector<Vec<3>>&, const std::v
 template void Builder<3>::refuseOverlap(SectionReader&, const std::vector<Vec<3>>&,
                                         const std::vector<double>&, const std::string&);
 template bool Builder<3>::freeFormBodyGiven() const;
+template bool Builder<3>::meshBodyGiven() const;
 template void Builder<3>::fillFreeFormBody();
 template void Builder<3>::checkIntegrationConstraint();
 template const SurfacePatch<3>& Builder<3>::namedSurface(SectionReader&, const std::string&);

@@ -1,6 +1,7 @@
 // The explicit stable time step (method/TimeStep.hpp): dt = C min_I dx_I / c_eff,I with
-// dx_I = V_I^(1/d), c_eff^2 = c^2 + kappa dx^2 K_I / m_I, kappa = 1/16; the particle that sets
-// it is reported; only free particles count when there are any; candidates restrict the set.
+// dx_I = V_I^(1/d) (or the neighbourhood spacing given), c_eff^2 = c^2 + kappa dx^2 K_I / m_I,
+// kappa = 1/16; the particle that sets it is reported; only free particles count when there are
+// any; candidates restrict the set.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -73,4 +74,27 @@ TEST(TimeStep, OnlyFreeParticlesAndCandidatesCount) {
   for (auto& m : p.particles.motion)
     m = Motion::Prescribed;
   EXPECT_EQ(stableStep(p.particles, p.materials, 0.3).particle, 2);
+}
+
+// dx_I is the spacing of I's neighbourhood: equal volumes give V^(1/d) exactly; a small cell
+// among normal ones takes its neighbours' mean, so it does not set the step.
+TEST(TimeStep, NeighbourhoodSpacingIgnoresOneSmallCell) {
+  NeighbourList nb;
+  nb.offset = {0, 2, 4, 6};
+  nb.neighbour = {1, 2, 0, 2, 0, 1};
+  const std::vector<double> equal = {0.3e-4, 0.3e-4, 0.3e-4};
+  for (double dx : neighbourhoodSpacing<2>(nb, equal))
+    EXPECT_EQ(dx, std::sqrt(0.3e-4));
+  ThreeParticles p;
+  p.particles.volume = {1e-4, 1e-4, 0.01e-4};  // particle 2: a cell of 0.1 dx
+  const std::vector<double> dx = neighbourhoodSpacing<2>(nb, p.particles.volume);
+  EXPECT_NEAR(dx[2], std::sqrt(2.01e-4 / 3.0), 1e-15);
+  const StableStep s = stableStep(p.particles, p.materials, 0.3, {}, nullptr, dx);
+  EXPECT_EQ(s.dx, dx[s.particle]);
+  EXPECT_EQ(s.particle, 1);  // the same spacing everywhere: the faster material sets it
+  EXPECT_NEAR(s.dt, 0.3 * dx[1] / pWaveSpeed(8.0e6, 0.25, 2000.0), 1e-15);
+  // without a list a particle keeps its own cell
+  nb.offset = {0, 2, 4, 4};
+  nb.neighbour = {1, 2, 0, 2};
+  EXPECT_EQ(neighbourhoodSpacing<2>(nb, p.particles.volume)[2], std::sqrt(0.01e-4));
 }
