@@ -254,15 +254,17 @@ struct ElementRule {
   int dim = 0, order = 0, nodes = 0, corners = 0;
   std::string name;
   std::vector<double> weight;
-  std::vector<double> grad;   // [point][node][3]
-  std::vector<double> hat;    // [point][corner]
-  std::vector<double> value;  // [point][node], moments only
+  std::vector<double> grad;     // [point][node][3]
+  std::vector<double> hat;      // [point][corner]
+  std::vector<double> value;    // [point][node], moments only
+  std::vector<double> nodeHat;  // [node][corner]: the corners' linear hats at each node
   std::size_t points() const { return weight.size(); }
 };
 
 // What a rule integrates: a D-element's volume (hat times det J), its moments (the same times
-// a quadratic in x, of degree 2 order in the reference coordinates), or a facet's area.
-enum class RuleUse { Volume, Moments, Facet };
+// a quadratic in x, of degree 2 order in the reference coordinates; on a straight-sided simplex,
+// whose map is affine, degree 3), or a facet's area.
+enum class RuleUse { Volume, Moments, StraightMoments, Facet };
 
 std::string familyName(int dim, int corners) {
   if (dim == 1 && corners == 2) return "Line";
@@ -296,6 +298,7 @@ ElementRule makeRule(int type, RuleUse use) {
   else
     degree = rule.dim * rule.order + 1;
   if (use == RuleUse::Moments) degree += 2 * rule.order;
+  if (use == RuleUse::StraightMoments) degree = 3;
   degree = std::max(degree, 4);  // gmsh's tensor rules below Gauss4 are not Gauss products
   std::vector<double> points;
   for (;; ++degree) {
@@ -310,10 +313,26 @@ ElementRule makeRule(int type, RuleUse use) {
   const int linear = gmsh::model::mesh::getElementType(family, 1);
   gmsh::model::mesh::getBasisFunctions(linear, points, "Lagrange", components, rule.hat,
                                        orientations);
-  if (use == RuleUse::Moments)
+  if (use == RuleUse::Moments || use == RuleUse::StraightMoments)
     gmsh::model::mesh::getBasisFunctions(type, points, "Lagrange", components, rule.value,
                                          orientations);
+  gmsh::model::mesh::getBasisFunctions(linear, local, "Lagrange", components, rule.nodeHat,
+                                       orientations);
   return rule;
+}
+
+// A simplex whose higher-order nodes sit where its corners' linear map puts them (all of a
+// curved mesh's elements but those at curved boundaries): its map is affine.
+bool straightSimplex(const ElementRule& rule, const std::vector<Vec3>& x) {
+  if (rule.corners != rule.dim + 1) return false;
+  const double tolerance = 1e-10 * (x[1] - x[0]).norm();
+  for (int a = rule.corners; a < rule.nodes; ++a) {
+    Vec3 linear = Vec3::Zero();
+    for (int c = 0; c < rule.corners; ++c)
+      linear += rule.nodeHat[a * rule.corners + c] * x[c];
+    if (!((linear - x[a]).norm() <= tolerance)) return false;
+  }
+  return true;
 }
 
 class RuleCache {
@@ -638,7 +657,8 @@ MeshedBody<D> meshBody(const std::string& path, double size, const MeshOptions& 
     Mat<D> entitySecond = Mat<D>::Zero();
     for (const auto& block : blocks[k]) {
       const ElementRule& r = rule(block.type, RuleUse::Volume);
-      const ElementRule& rm = rule(block.type, RuleUse::Moments);
+      const ElementRule& curvedRule = rule(block.type, RuleUse::Moments);
+      const ElementRule& straightRule = rule(block.type, RuleUse::StraightMoments);
       const std::size_t n = block.nodes.size() / r.nodes;
       for (std::size_t e = 0; e < n; ++e) {
         const std::size_t* tags = &block.nodes[e * r.nodes];
@@ -665,7 +685,9 @@ MeshedBody<D> meshBody(const std::string& path, double size, const MeshOptions& 
           for (int a = 0; a < r.corners; ++a)
             contribution[first + a].second += r.hat[q * r.corners + a] * dv;
         }
-        // The moments, on the same geometry with a rule of 2 order degrees more.
+        // The moments, on the same geometry with a rule of 2 order degrees more (exact for an
+        // affine simplex at degree 3: most of a mesh, at a fraction of the points).
+        const ElementRule& rm = straightSimplex(r, x) ? straightRule : curvedRule;
         momentContribution.resize(contribution.size(), {Vec<D>::Zero(), Mat<D>::Zero()});
         for (std::size_t q = 0; q < rm.points(); ++q) {
           Vec3 c[3];
