@@ -1473,7 +1473,7 @@ NOTES.update({
     "bracket": "The L-bracket of examples/bracket.ini (3D, gmsh tetrahedra from CAD, "
                "particles = corner nodes; nodal clamp on the bore, pressure on the arm's "
                "face). 'Per thickness' = elements through the 10 mm walls (dx = 5, 3.5, "
-               "2.5, 1.75 mm). u_x and u_z of the arm's top corner P = (0, 0, 0.06) from a "
+               "2.5, 1.75, 1.25, 1.0 mm). u_x and u_z of the arm's top corner P = (0, 0, 0.06) from a "
                "kernel probe, errors along the FEM's direction (positive = too soft).",
 })
 
